@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# One-command set-up on a fresh Debian 12 machine (root, or a user with sudo).
+#
+#   scripts/setup.sh          install what is missing, then build both catkin workspaces
+#
+# Steps: Debian's ROS 1 packages -> .venv from /usr/bin/python3 (--system-site-packages, so
+# Debian's rospy stays importable) -> pinned PyPI packages -> catkin_make simulation_ws, then
+# catkin_ws on top of it. Idempotent: on a ready machine it only re-checks and re-runs the
+# (incremental) catkin builds.
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+VENV="$ROOT/.venv"
+SYSTEM_PYTHON=/usr/bin/python3
+STEP="start"
+
+say()  { printf '[setup] %s\n' "$*"; }
+fail() { printf '[setup] FAILED at step "%s": %s\n' "$STEP" "$*" >&2; exit 1; }
+trap 'rc=$?; [ $rc -eq 0 ] || printf "[setup] FAILED at step \"%s\" (exit %d); see the output above\n" "$STEP" "$rc" >&2' EXIT
+
+# Debian's ROS 1 packages (Noetic-era ros_comm 1.15) the project needs at run, build and test time.
+APT_PACKAGES=(
+  python3-venv python3-pip cmake g++ make
+  catkin python3-catkin-pkg ros-message-generation ros-message-runtime python3-genpy
+  ros-std-msgs libstd-msgs-dev python3-std-msgs ros-geometry-msgs libstd-srvs-dev python3-std-srvs
+  libgeometry-msgs-dev python3-geometry-msgs libsensor-msgs-dev python3-sensor-msgs
+  libnav-msgs-dev python3-nav-msgs python3-rosgraph-msgs python3-tf2-ros python3-tf2-msgs
+  python3-rospy python3-rostest python3-rosunit librostest-dev python3-roslaunch
+  python3-rosmaster rosout rosbash python3-rostopic python3-rosservice python3-rosnode
+  python3-rosparam python3-rosmsg python3-rosbag
+)
+
+STEP="check machine"
+[ -x "$SYSTEM_PYTHON" ] || fail "$SYSTEM_PYTHON not found; this script is for Debian 12 (bookworm)"
+command -v dpkg-query >/dev/null || fail "dpkg-query not found; this script is for Debian 12 (bookworm)"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || fail "run as root or install sudo"
+  SUDO="sudo"
+fi
+
+STEP="Debian packages"
+missing=()
+for pkg in "${APT_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  say "1/4 Debian packages: all ${#APT_PACKAGES[@]} present"
+else
+  say "1/4 Debian packages: installing ${#missing[@]} missing: ${missing[*]}"
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -q
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+STEP="virtual environment"
+if [ -x "$VENV/bin/python" ] && grep -q "^home = /usr/bin$" "$VENV/pyvenv.cfg" 2>/dev/null \
+   && grep -q "^include-system-site-packages = true$" "$VENV/pyvenv.cfg"; then
+  say "2/4 virtual environment: $VENV ready"
+else
+  say "2/4 virtual environment: creating $VENV from $SYSTEM_PYTHON (--system-site-packages)"
+  rm -rf "$VENV"
+  "$SYSTEM_PYTHON" -m venv --system-site-packages "$VENV"
+fi
+
+STEP="PyPI packages"
+stamp="$VENV/.requirements.sha256"
+want="$(sha256sum "$ROOT/requirements.txt" | cut -d' ' -f1)"
+if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
+  say "3/4 PyPI packages: requirements.txt unchanged since last install"
+else
+  say "3/4 PyPI packages: installing requirements.txt (pybullet is a ~100 MB wheel)"
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r "$ROOT/requirements.txt"
+  "$VENV/bin/python" -c "import rospy, pybullet, numpy, xacro" \
+    || fail "the venv cannot import rospy, pybullet, numpy and xacro together"
+  echo "$want" > "$stamp"
+fi
+
+STEP="catkin build"
+export PATH="$VENV/bin:$PATH"        # catkin_make must find the venv's python3, not pyenv's
+unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH
+build_ws() {
+  local ws="$1"
+  say "4/4 catkin_make $ws"
+  (cd "$ROOT/$ws" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python3" \
+      -DCATKIN_ENABLE_TESTING=ON > "$ROOT/$ws/build.log" 2>&1) \
+    || { tail -n 40 "$ROOT/$ws/build.log" >&2; fail "catkin_make in $ws failed; full log: $ws/build.log"; }
+}
+build_ws simulation_ws
+# catkin_ws overlays simulation_ws, as in the tutorial's environment where both are sourced.
+set +u; source "$ROOT/simulation_ws/devel/setup.bash"; set -u
+build_ws catkin_ws
+
+STEP="done"
+say "ready: run 'source scripts/env.sh' to use roscore, roslaunch and rosrun"

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Runs every test suite: scripts/setup.sh (if anything is missing), the fast unit tests with
+# pytest (no ROS master), then the rostest suites of both workspaces through catkin.
+# Exits non-zero when any test fails or a rostest crashed without writing its results, and
+# ends with one line `N passed, N failed, N skipped`.
+#
+#   scripts/test.sh            everything
+#   scripts/test.sh --unit     only the pytest unit tests
+set -uo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+RESULTS="$ROOT/test_results"
+mode="${1:-all}"
+
+bash "$ROOT/scripts/setup.sh" || { echo "[test] setup failed; no test was run"; echo "0 passed, 1 failed"; exit 1; }
+set +u; source "$ROOT/scripts/env.sh"; set -u
+rm -rf "$RESULTS" && mkdir -p "$RESULTS"
+
+status=0
+echo "[test] unit tests (pytest, no ROS master)"
+unit_dirs=()
+for d in "$ROOT"/simulation_ws/src/*/test/unit "$ROOT"/catkin_ws/src/*/test/unit "$ROOT/scripts/test"; do
+  [ -d "$d" ] && unit_dirs+=("$d")
+done
+python -m pytest -q -W error -p no:cacheprovider --junitxml="$RESULTS/pytest-unit.xml" "${unit_dirs[@]}" \
+  || status=1
+
+if [ "$mode" != "--unit" ]; then
+  for ws in simulation_ws catkin_ws; do
+    echo "[test] rostest suites of $ws (catkin_make run_tests, one at a time)"
+    set +u; source "$ROOT/$ws/devel/setup.bash"; set -u
+    export PATH="$ROOT/.venv/bin:$PATH"
+    (cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 2>&1) > "$RESULTS/$ws-run_tests.log"
+    # one progress line per suite; the full output stays in the log
+    grep -E "^-- run_tests.py: execute|^\[ROSTEST\]|^ *\[.*\]\[(passed|FAILURE|ERROR)\]|^SUMMARY|^ \* RESULT" \
+      "$RESULTS/$ws-run_tests.log" | sed 's/^/    /'
+    cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
+  done
+  set +u; source "$ROOT/scripts/env.sh"; set -u
+fi
+
+python "$ROOT/scripts/summarize_test_results.py" "$RESULTS" || status=1
+exit $status
