@@ -22,7 +22,7 @@ unit_dirs=()
 for d in "$ROOT"/simulation_ws/src/*/test/unit "$ROOT"/catkin_ws/src/*/test/unit "$ROOT/scripts/test"; do
   [ -d "$d" ] && unit_dirs+=("$d")
 done
-python -m pytest -q -W error -p no:cacheprovider --junitxml="$RESULTS/pytest-unit.xml" "${unit_dirs[@]}" \
+python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib --junitxml="$RESULTS/pytest-unit.xml" "${unit_dirs[@]}" \
   || status=1
 
 if [ "$mode" != "--unit" ]; then

@@ -1,0 +1,120 @@
+#!/usr/bin/env python3
+"""rostest: m2wr obeys /cmd_vel as gazebo_ros_diff_drive (Noetic) drives it, and /odom tells
+the truth.
+
+Expected motion, from the plugin's formula and the robot's real geometry:
+- (v, w) = (0.6, 0): both wheels at 0.6 / 0.1 = 6 rad/s -> 0.6 m/s along the heading.
+- (v, w) = (0, 0.3): the joint *named* joint_left_wheel (at -y, the robot's right) gets
+  -0.3 * 0.4 / 2 / 0.1 = -0.6 rad/s, joint_right_wheel (at +y, its left) +0.6 rad/s. The
+  left side rolls forward at 0.06 m/s, the right side back: clockwise at 0.12 / 0.3 = 0.4 rad/s.
+"""
+import math
+import time
+import unittest
+
+import rospy
+import rostest
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from std_srvs.srv import Empty
+from gazebo_msgs.srv import GetModelState
+
+from pybullet_gazebo.ros.testing import service, unwrap_angle, wait_for_message, wait_until_sim_time
+
+WHEEL_RADIUS = 0.1          # [m]
+FORMULA_SEPARATION = 0.4    # [m] wheelSeparation in the plugin block
+REAL_SEPARATION = 0.3       # [m] joints at y = +-0.15
+
+
+class DriveTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_drive")
+        cls.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
+        cls.get_state = service("/gazebo/get_model_state", GetModelState, timeout=30)
+        cls.pause = service("/gazebo/pause_physics", Empty)
+        cls.unpause = service("/gazebo/unpause_physics", Empty)
+        cls.last_odom = None
+        rospy.Subscriber("/odom", Odometry, cls.on_odom)
+        wait_for_message("/odom", Odometry, timeout=30)
+        deadline = time.monotonic() + 10
+        while cls.cmd.get_num_connections() == 0 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        wait_until_sim_time(rospy.get_time() + 1.0)          # dropped from z 0.5, settled
+
+    @classmethod
+    def on_odom(cls, msg):
+        cls.last_odom = msg
+
+    def state(self):
+        answer = self.get_state("m2wr", "world")
+        self.assertTrue(answer.success, answer.status_message)
+        q = answer.pose.orientation
+        yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+        return answer.header.stamp.to_sec(), answer.pose.position.x, answer.pose.position.y, yaw
+
+    def drive(self, linear, angular, duration):
+        """Commands (linear, angular) for `duration` s of sim time, measured exactly by
+        pausing physics around it; returns the states before and after."""
+        self.pause()
+        self.cmd.publish(Twist())
+        command = Twist()
+        command.linear.x, command.angular.z = linear, angular
+        self.cmd.publish(command)
+        time.sleep(0.2)                                      # delivered while paused
+        start = self.state()
+        self.unpause()
+        wait_until_sim_time(start[0] + duration)
+        self.pause()
+        end = self.state()
+        self.cmd.publish(Twist())
+        time.sleep(0.2)
+        self.unpause()
+        return start, end
+
+    def test_1_straight_run_moves_three_metres_along_the_heading(self):
+        start, end = self.drive(0.6, 0.0, 5.0)
+        elapsed = end[0] - start[0]
+        dx, dy = end[1] - start[1], end[2] - start[2]
+        along = dx * math.cos(start[3]) + dy * math.sin(start[3])
+        across = -dx * math.sin(start[3]) + dy * math.cos(start[3])
+        self.assertGreaterEqual(elapsed, 5.0)
+        self.assertAlmostEqual(along, 0.6 * elapsed, delta=0.05 * 0.6 * elapsed)
+        self.assertLess(abs(across), 0.1)
+
+    def test_2_positive_angular_z_turns_m2wr_clockwise(self):
+        start, end = self.drive(0.0, 0.3, 3.0)
+        rate = unwrap_angle(end[3] - start[3]) / (end[0] - start[0])
+        wheel_rim_speed = 0.3 * FORMULA_SEPARATION / 2          # [m/s] each side
+        expected = -2 * wheel_rim_speed / REAL_SEPARATION       # [rad/s] clockwise: -0.4
+        self.assertLess(rate, 0.0, "a positive angular.z must turn m2wr clockwise")
+        self.assertAlmostEqual(rate, expected, delta=0.1 * abs(expected))
+        # it turns on the spot: the chassis frame moves little
+        self.assertLess(math.hypot(end[1] - start[1], end[2] - start[2]), 0.15)
+
+    def test_3_odometry_agrees_with_the_true_pose(self):
+        self.cmd.publish(Twist())
+        wait_until_sim_time(rospy.get_time() + 1.0)
+        odom = self.last_odom
+        stamp, x, y, yaw = self.state()
+        self.assertEqual(odom.header.frame_id, "odom")
+        self.assertEqual(odom.child_frame_id, "link_chassis")
+        self.assertAlmostEqual(odom.pose.pose.position.x, x, delta=0.01)
+        self.assertAlmostEqual(odom.pose.pose.position.y, y, delta=0.01)
+        q = odom.pose.pose.orientation
+        odom_yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+        self.assertAlmostEqual(unwrap_angle(odom_yaw - yaw), 0.0, delta=0.01)
+
+    def test_4_odometry_twist_is_in_the_robot_frame(self):
+        command = Twist()
+        command.linear.x = 0.6
+        self.cmd.publish(command)
+        wait_until_sim_time(rospy.get_time() + 1.0)
+        odom = self.last_odom
+        self.cmd.publish(Twist())
+        self.assertAlmostEqual(odom.twist.twist.linear.x, 0.6, delta=0.05)
+        self.assertLess(abs(odom.twist.twist.linear.y), 0.05)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("m2wr_description", "drive", DriveTest)

@@ -1,0 +1,43 @@
+#!/usr/bin/env python3
+"""rostest: with a master but no simulator, spawn_model fails within 10 s (Gazebo's own client
+waits for ever) and tells the user to start the world."""
+import subprocess
+import time
+import unittest
+
+import rospy
+import rostest
+
+
+class SpawnWithoutSimulatorTest(unittest.TestCase):
+    def test_gives_up_within_ten_seconds_and_says_what_to_do(self):
+        started = time.monotonic()
+        result = subprocess.run(["rosrun", "pybullet_gazebo", "spawn_model", "-urdf", "-param",
+                                 "robot_description", "-model", "m2wr", "-y", "8"],
+                                capture_output=True, text=True, timeout=40)
+        elapsed = time.monotonic() - started
+        self.assertEqual(result.returncode, 1)
+        self.assertLess(elapsed, 12.0)           # 10 s of waiting plus start-up
+        self.assertIn("launch_world.launch", result.stderr)
+        self.assertIn("start the world", result.stderr)
+
+    def test_empty_description_is_refused(self):
+        rospy.set_param("/empty_description", "")
+        result = subprocess.run(["rosrun", "pybullet_gazebo", "spawn_model", "-urdf", "-param",
+                                 "empty_description", "-model", "m2wr"],
+                                capture_output=True, text=True, timeout=40)
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("empty", result.stderr)
+
+    def test_malformed_description_is_refused_with_its_line(self):
+        rospy.set_param("/broken_description", "<robot name='m2wr'>\n<link name='a'>\n</robot>")
+        result = subprocess.run(["rosrun", "pybullet_gazebo", "spawn_model", "-urdf", "-param",
+                                 "broken_description", "-model", "m2wr"],
+                                capture_output=True, text=True, timeout=40)
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("not valid XML (line 3", result.stderr)
+
+
+if __name__ == "__main__":
+    rospy.init_node("test_spawn_without_simulator")
+    rostest.rosrun("m2wr_description", "spawn_without_simulator", SpawnWithoutSimulatorTest)

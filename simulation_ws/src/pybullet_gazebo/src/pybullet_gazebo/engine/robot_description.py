@@ -1,0 +1,346 @@
+"""Reads a URDF robot description (the `robot_description` parameter, as xacro expands it) for
+what Gazebo would take from it beyond links and joints, and cleans it for pybullet's loader.
+
+- `parse_robot(urdf_xml, model_name)` -> `specs.RobotSpec`: the root link, the `<gazebo>`
+  tags (model plugins such as libgazebo_ros_diff_drive.so, ray sensors with their
+  libgazebo_ros_laser.so plugin, `<mu1>`/`<mu2>` per link) and the SDF-style
+  `<surface><friction><ode><mu>/<mu2>` written inside URDF `<collision>` elements.
+  Anything it does not simulate becomes a warning naming the tag (`RobotSpec.warnings`);
+  a description it cannot use raises `RobotDescriptionError` saying what and where.
+- `strip_for_bullet(urdf_xml)` -> the same URDF with only URDF elements left (no `<gazebo>`
+  blocks, no link `<pose>`, no collision `<surface>`), for `loadURDF`.
+- `effective_link_friction(spec)` -> one (mu1, mu2) per link, by the rule below.
+
+Friction rule. Bullet holds one friction per link, while a URDF link may have several
+collisions. For each link:
+1. `<gazebo reference="LINK">` `<mu1>`/`<mu2>` win: Gazebo applies them to every collision of
+   the link.
+2. Otherwise, if some of its collisions carry `<surface>` friction, the link gets the lowest
+   mu and the lowest mu2 among those collisions; collisions without `<surface>` do not count.
+   Such a collision is the part of the body meant to touch the ground (a caster or skid); the
+   rest of the body does not. m2wr: the chassis box rides 0.1 m above the ground and only its
+   caster sphere (mu = mu2 = 0) touches, so link_chassis gets (0, 0). This is a rule, not a
+   fault: no warning is given for it.
+3. Otherwise the link is not listed and takes Gazebo's default (mu = mu2 = 1).
+A value missing from a pair (`<mu1>` without `<mu2>`, `<mu>` without `<mu2>`) is 1, SDF's
+default. Collision keys are (link name, collision name), or (link name, "N") for the N-th
+(0-based) collision of the link when it has no name.
+
+No pybullet here: plain XML (xml.etree) in, `specs` dataclasses and text out.
+"""
+import dataclasses
+import math
+import xml.etree.ElementTree as ET
+from typing import Dict, List, Optional, Tuple
+
+from .specs import PluginSpec, RaySensorSpec, RobotSpec
+from .transforms import Pose
+
+
+class RobotDescriptionError(Exception):
+    """The robot description cannot be used; the message says what is wrong and where."""
+
+
+DEFAULT_MU = 1.0                     # SDF's (ODE's) default friction coefficient
+
+# The elements a URDF may hold, per parent; strip_for_bullet drops everything else.
+# `contact` under `link` is pybullet's own URDF extension and is kept for it.
+_URDF_CHILDREN = {
+    "robot": {"link", "joint", "material", "transmission"},
+    "link": {"inertial", "visual", "collision", "contact"},
+    "inertial": {"origin", "mass", "inertia"},
+    "visual": {"origin", "geometry", "material"},
+    "collision": {"origin", "geometry"},
+    "joint": {"origin", "parent", "child", "axis", "limit", "dynamics", "calibration",
+              "mimic", "safety_controller"},
+}
+
+# Children of a <sensor> that change nothing the stand-in simulates.
+_SENSOR_TAGS_IGNORED = {"visualize", "always_on", "topic"}
+
+
+def parse_robot(urdf_xml: str, model_name: str) -> RobotSpec:
+    """The RobotSpec of a URDF text. Raises RobotDescriptionError when the text is empty,
+    not XML, not a <robot>, has no single root link, or holds a value that is not a number
+    where a number must be."""
+    root = _parse_xml(urdf_xml)
+    links, joints = _links_and_joints(root)
+    root_link = _root_link(links, joints)
+    warnings: List[str] = []
+    plugins: List[PluginSpec] = []
+    sensors: List[RaySensorSpec] = []
+    mu_given: Dict[str, List[Optional[float]]] = {}
+
+    for block in root.findall("gazebo"):
+        reference = block.get("reference")
+        if reference is None:
+            for child in block:
+                if child.tag == "plugin":
+                    plugins.append(_plugin(child, "<gazebo>"))
+                else:
+                    warnings.append("<gazebo>: <%s> is not supported by the stand-in; ignored"
+                                    % child.tag)
+            continue
+        where = '<gazebo reference="%s">' % reference
+        if reference not in links:
+            if any(child.tag == "sensor" for child in block):
+                raise RobotDescriptionError(
+                    "%s holds a <sensor> but the robot has no link '%s'; name one of its "
+                    "links: %s" % (where, reference, ", ".join(links)))
+            what = "joint" if reference in joints else "no link of the robot"
+            for child in block:
+                warnings.append("%s (%s): <%s> is not supported by the stand-in; ignored"
+                                % (where, what, child.tag))
+            continue
+        for child in block:
+            if child.tag in ("mu1", "mu2"):
+                pair = mu_given.setdefault(reference, [None, None])
+                pair[0 if child.tag == "mu1" else 1] = _float(child, "%s <%s>" % (where,
+                                                                                  child.tag))
+            elif child.tag == "material":
+                pass                       # a colour: nothing to simulate
+            elif child.tag == "sensor":
+                sensor_type = child.get("type", "")
+                if sensor_type == "ray":
+                    sensors.append(_ray_sensor(child, reference, warnings))
+                else:
+                    warnings.append("%s: sensor '%s' of type '%s' on link '%s' is not "
+                                    "simulated by the stand-in; ignored"
+                                    % (where, child.get("name", ""), sensor_type, reference))
+            else:
+                warnings.append("%s: <%s> is not supported by the stand-in; ignored"
+                                % (where, child.tag))
+
+    link_friction = {link: tuple(DEFAULT_MU if v is None else v for v in pair)
+                     for link, pair in mu_given.items()}
+    return RobotSpec(name=model_name, root_link=root_link, plugins=tuple(plugins),
+                     sensors=tuple(sensors), link_friction=link_friction,
+                     collision_friction=_collision_friction(root),
+                     warnings=tuple(warnings))
+
+
+def strip_for_bullet(urdf_xml: str) -> str:
+    """The URDF with only URDF elements kept (see _URDF_CHILDREN): `<gazebo>` blocks, a
+    link's `<pose>`, a collision's `<surface>` and any other foreign element are removed;
+    comments go too. Raises RobotDescriptionError as parse_robot does for bad text."""
+    root = _parse_xml(urdf_xml)
+    _strip(root)
+    for element in root.iter():         # re-indent what the removals left ragged
+        if element.text is not None and not element.text.strip():
+            element.text = None
+        element.tail = None
+    ET.indent(root, "  ")
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def effective_link_friction(spec: RobotSpec) -> Dict[str, Tuple[float, float]]:
+    """(mu1, mu2) for every link the description gives a friction, by the module's rule:
+    the link's <gazebo> mu1/mu2, else the lowest <surface> values of its collisions."""
+    result: Dict[str, Tuple[float, float]] = {}
+    for (link, _), (mu, mu2) in spec.collision_friction.items():
+        if link in result:
+            mu, mu2 = min(mu, result[link][0]), min(mu2, result[link][1])
+        result[link] = (mu, mu2)
+    result.update(spec.link_friction)
+    return result
+
+
+# --- helpers -----------------------------------------------------------------------------
+def _parse_xml(urdf_xml):
+    if urdf_xml is None or not str(urdf_xml).strip():
+        raise RobotDescriptionError(
+            "robot_description is empty: there is no URDF to load; fill the parameter with "
+            "the output of xacro, as spawn.launch does")
+    try:
+        root = ET.fromstring(urdf_xml)
+    except ET.ParseError as err:
+        line, column = err.position
+        raise RobotDescriptionError(
+            "robot_description is not valid XML: line %d, column %d: %s; check the file "
+            "(or run xacro on it and read the output)" % (line, column + 1, _reason(err)))
+    if root.tag != "robot":
+        raise RobotDescriptionError(
+            "robot_description's root element is <%s>, not <robot>: it is not a URDF; pass a "
+            "URDF (spawn_model -urdf)" % root.tag)
+    return root
+
+
+def _reason(err):
+    """ParseError's message without its own ': line L, column C' suffix."""
+    text = str(err)
+    return text.split(": line ")[0] if ": line " in text else text
+
+
+def _links_and_joints(root):
+    links: List[str] = []
+    for link in root.findall("link"):
+        name = link.get("name")
+        if not name:
+            raise RobotDescriptionError("a <link> of the URDF has no name=; name every link")
+        if name in links:
+            raise RobotDescriptionError("link '%s' is defined twice in the URDF; rename one"
+                                        % name)
+        links.append(name)
+    if not links:
+        raise RobotDescriptionError("the URDF <robot name=\"%s\"> has no <link>; a robot "
+                                    "needs at least one" % root.get("name", ""))
+    joints: Dict[str, Tuple[str, str]] = {}
+    for joint in root.findall("joint"):
+        name = joint.get("name", "")
+        parent, child = joint.find("parent"), joint.find("child")
+        ends = []
+        for end, tag in ((parent, "parent"), (child, "child")):
+            link = None if end is None else end.get("link")
+            if link not in links:
+                raise RobotDescriptionError(
+                    "joint '%s': its <%s link=...> names %s, which is not a link of the URDF; "
+                    "name one of: %s" % (name, tag, "no link" if link is None else
+                                         "'%s'" % link, ", ".join(links)))
+            ends.append(link)
+        joints[name] = (ends[0], ends[1])
+    return links, joints
+
+
+def _root_link(links, joints):
+    children = {child for _, child in joints.values()}
+    roots = [link for link in links if link not in children]
+    if len(roots) == 1:
+        return roots[0]
+    if not roots:
+        raise RobotDescriptionError(
+            "the URDF has no root link: every link is the child of a joint (a loop?); the "
+            "joints must form a tree")
+    raise RobotDescriptionError(
+        "the URDF has %d root links (%s): every link but one must be the child of a joint; "
+        "connect them with joints" % (len(roots), ", ".join(roots)))
+
+
+def _float(element, where):
+    text = (element.text or "").strip()
+    try:
+        value = float(text)
+    except ValueError:
+        raise RobotDescriptionError("%s is '%s', not a number; fix the URDF" % (where, text))
+    if math.isnan(value):
+        raise RobotDescriptionError("%s is NaN; fix the URDF" % where)
+    return value
+
+
+def _number(parent, path, where, default, cast=float):
+    element = parent.find(path)
+    if element is None:
+        return default
+    value = _float(element, "%s <%s>" % (where, path))
+    if cast is int:
+        if value != int(value):
+            raise RobotDescriptionError("%s <%s> is %s, not a whole number; fix the URDF"
+                                        % (where, path, element.text.strip()))
+        return int(value)
+    return value
+
+
+def _plugin(element, where):
+    filename = element.get("filename")
+    if not filename:
+        raise RobotDescriptionError("%s: a <plugin> has no filename=; give the library, "
+                                    "e.g. libgazebo_ros_diff_drive.so" % where)
+    params = {child.tag: "".join(child.itertext()).strip() for child in element}
+    return PluginSpec(name=element.get("name", filename), filename=filename, params=params)
+
+
+def _ray_sensor(sensor, link, warnings):
+    name = sensor.get("name", "")
+    where = "sensor '%s' on link '%s':" % (name, link)
+    pose_element = sensor.find("pose")
+    try:
+        pose = Pose.parse_sdf(pose_element.text if pose_element is not None else "")
+    except ValueError as err:
+        raise RobotDescriptionError("%s <pose>: %s" % (where, err))
+    ray = sensor.find("ray")
+    if ray is None:
+        ray = ET.Element("ray")
+        warnings.append("%s has no <ray>; Gazebo's defaults are used" % where)
+    defaults = RaySensorSpec(name=name, link=link)
+    horizontal = "scan/horizontal/"
+    spec = RaySensorSpec(
+        name=name, link=link, pose=pose,
+        update_rate=_number(sensor, "update_rate", where, defaults.update_rate),
+        samples=_number(ray, horizontal + "samples", where, defaults.samples, int),
+        min_angle=_number(ray, horizontal + "min_angle", where, defaults.min_angle),
+        max_angle=_number(ray, horizontal + "max_angle", where, defaults.max_angle),
+        range_min=_number(ray, "range/min", where, defaults.range_min),
+        range_max=_number(ray, "range/max", where, defaults.range_max),
+        resolution=_number(ray, "range/resolution", where, defaults.resolution),
+        noise_mean=_number(ray, "noise/mean", where, defaults.noise_mean),
+        noise_stddev=_number(ray, "noise/stddev", where, defaults.noise_stddev),
+        plugin=None)
+    _check_ray(spec, where)
+
+    if _number(ray, horizontal + "resolution", where, 1.0) != 1.0:
+        warnings.append("%s <scan><horizontal><resolution> other than 1 is not simulated; "
+                        "one ray per sample is cast" % where)
+    if ray.find("scan/vertical") is not None:
+        warnings.append("%s <scan><vertical> is not simulated; the scan is planar" % where)
+    noise_type = ray.find("noise/type")
+    if noise_type is not None and (noise_type.text or "").strip() not in ("gaussian", "none"):
+        warnings.append("%s noise type '%s' is not simulated; Gaussian noise is used"
+                        % (where, (noise_type.text or "").strip()))
+
+    plugin = None
+    for child in sensor:
+        if child.tag == "plugin":
+            if plugin is None:
+                plugin = _plugin(child, where)
+            else:
+                warnings.append("%s a second <plugin> (%s) is ignored; one per sensor"
+                                % (where, child.get("filename", "")))
+        elif child.tag not in {"pose", "update_rate", "ray"} | _SENSOR_TAGS_IGNORED:
+            warnings.append("%s <%s> is not supported by the stand-in; ignored"
+                            % (where, child.tag))
+    return dataclasses.replace(spec, plugin=plugin)
+
+
+def _check_ray(spec, where):
+    problems = []
+    if spec.samples < 1:
+        problems.append("<samples> is %d; it must be 1 or more" % spec.samples)
+    if spec.max_angle < spec.min_angle:
+        problems.append("<max_angle> %g is below <min_angle> %g" % (spec.max_angle,
+                                                                     spec.min_angle))
+    if not 0.0 <= spec.range_min < spec.range_max:
+        problems.append("range <min> %g and <max> %g must satisfy 0 <= min < max"
+                        % (spec.range_min, spec.range_max))
+    if spec.update_rate < 0.0:
+        problems.append("<update_rate> is %g; it must be 0 (every step) or more"
+                        % spec.update_rate)
+    if spec.noise_stddev < 0.0:
+        problems.append("noise <stddev> is %g; it must be 0 or more" % spec.noise_stddev)
+    if problems:
+        raise RobotDescriptionError("%s %s; fix the <gazebo> block" % (where,
+                                                                     "; ".join(problems)))
+
+
+def _collision_friction(root):
+    result = {}
+    for link in root.findall("link"):
+        for index, collision in enumerate(link.findall("collision")):
+            ode = collision.find("surface/friction/ode")
+            if ode is None:
+                continue
+            key = (link.get("name"), collision.get("name") or str(index))
+            where = "link '%s' collision '%s' <surface><friction><ode>" % key
+            mu = _number(ode, "mu", where, None)
+            mu2 = _number(ode, "mu2", where, None)
+            if mu is None and mu2 is None:
+                continue
+            result[key] = (DEFAULT_MU if mu is None else mu, DEFAULT_MU if mu2 is None else mu2)
+    return result
+
+
+def _strip(element):
+    allowed = _URDF_CHILDREN.get(element.tag)
+    for child in list(element):
+        if allowed is not None and child.tag not in allowed:
+            element.remove(child)
+        else:
+            _strip(child)

@@ -1,0 +1,421 @@
+"""The simulated world: Bullet bodies built from a WorldSpec, robots spawned from URDF with
+the components their `<gazebo>` tags ask for, fixed-step stepping, and what Gazebo's world
+services need (model states, reset, delete, contacts).
+
+Frames: a model's pose is its model frame in the world, as Gazebo reports it. A world model
+becomes one Bullet body per link; a robot is one Bullet multibody loaded from its URDF, whose
+model frame is its root link's frame. Bullet reports a body's inertial (centre-of-mass)
+frame; `_link_frame` converts.
+"""
+from dataclasses import dataclass, field
+import math
+import os
+import tempfile
+from typing import Callable, Dict, List, Optional
+
+import numpy as np
+import pybullet
+
+from .raycast import RayCaster
+from .registry import PLUGINS, SENSOR_PLUGINS, SENSORS
+from .robot_description import DEFAULT_MU, effective_link_friction, parse_robot, strip_for_bullet
+from .specs import Box, Cylinder, Mesh, Plane, Sphere, WorldSpec
+from .transforms import Pose
+
+
+class SpawnError(ValueError):
+    """A model could not be spawned; the message says why and what to do. The world is
+    left as it was."""
+
+
+class ModelNotFound(KeyError):
+    def __str__(self):
+        return str(self.args[0])
+
+
+@dataclass
+class Robot:
+    """A model spawned from a URDF, with its components."""
+    name: str
+    body_id: int
+    namespace: str
+    joints: Dict[str, int]
+    links: Dict[str, int]
+    initial_pose: Pose
+    components: list = field(default_factory=list)
+
+
+@dataclass
+class Entity:
+    """A model in the world: its Bullet bodies (one per link) and where it started."""
+    name: str
+    body_ids: List[int]
+    link_offsets: List[Pose]        # each body's link frame in the model frame
+    initial_pose: Pose              # model frame in the world at load/spawn
+    static: bool
+    is_ground: bool = False
+    robot: Optional[Robot] = None
+
+
+@dataclass(frozen=True)
+class ContactEvent:
+    """The start of a touch between a robot and another model (the ground excluded)."""
+    sim_time: float                 # [s]
+    robot: str
+    other: str
+
+
+@dataclass(frozen=True)
+class Reading:
+    """A component's output that is due this step (a scan, an odometry)."""
+    robot: Robot
+    component: object
+    data: object
+
+
+class World:
+    """Everything the simulator steps. `warn(message)` receives each problem once."""
+
+    def __init__(self, client, spec: WorldSpec, step_size: float, seed: int = 0,
+                 warn: Callable[[str], None] = print, command_timeout: float = 0.0):
+        if not (step_size > 0.0 and math.isfinite(step_size)):
+            raise ValueError("step_size %r must be a positive number of seconds" % step_size)
+        self.client = client
+        self.spec = spec
+        self.step_size = step_size                   # [s]
+        self.seed = seed
+        self.command_timeout = command_timeout       # [s]; 0 = hold the last command for ever
+        self.warn = warn
+        self.rng = np.random.default_rng(seed)
+        self.step_count = 0
+        self.entities: Dict[str, Entity] = {}
+        self.contact_events: List[ContactEvent] = []
+        self._touching = set()                       # (robot, other) pairs touching now
+        self._body_owner: Dict[int, str] = {}
+        self.caster = RayCaster(client)
+
+        client.resetSimulation()
+        client.setGravity(*spec.physics.gravity)
+        client.setPhysicsEngineParameter(fixedTimeStep=step_size, numSubSteps=1)
+        for message in spec.warnings:
+            warn(message)
+        for model in spec.models:
+            self._add_world_model(model)
+
+    # --- time ---------------------------------------------------------------------------
+    @property
+    def sim_time(self) -> float:
+        return self.step_count * self.step_size
+
+    def step(self) -> List[Reading]:
+        """Advances physics by one fixed step; returns the components' outputs now due."""
+        now = self.sim_time
+        robots = self.robots()
+        for robot in robots:
+            for component in robot.components:
+                if hasattr(component, "before_step"):
+                    component.before_step(now, self.step_size)
+        self.client.stepSimulation()
+        self.step_count += 1
+        now = self.sim_time
+        readings = []
+        for robot in robots:
+            for component in robot.components:
+                if hasattr(component, "after_step"):
+                    component.after_step(now)
+                if component.due(now):
+                    readings.append(Reading(robot, component, self._read(component, now)))
+        self._track_contacts(robots)
+        return readings
+
+    @staticmethod
+    def _read(component, now):
+        return component.measure(now) if hasattr(component, "measure") else component.odometry()
+
+    # --- models -------------------------------------------------------------------------
+    def model_names(self) -> List[str]:
+        return list(self.entities)
+
+    def robots(self) -> List[Robot]:
+        return [e.robot for e in self.entities.values() if e.robot is not None]
+
+    def entity(self, name) -> Entity:
+        try:
+            return self.entities[name]
+        except KeyError:
+            raise ModelNotFound("model '%s' does not exist; models are: %s"
+                                % (name, ", ".join(self.entities) or "(none)"))
+
+    def model_pose(self, name) -> Pose:
+        entity = self.entity(name)
+        body = entity.body_ids[0]
+        return self._link_frame(body).compose(entity.link_offsets[0].inverse())
+
+    def model_twist(self, name):
+        """(linear, angular) velocity of the model's first body, world frame [m/s], [rad/s]."""
+        linear, angular = self.client.getBaseVelocity(self.entity(name).body_ids[0])
+        return np.array(linear), np.array(angular)
+
+    def set_model_state(self, name, pose: Pose, linear=(0, 0, 0), angular=(0, 0, 0)):
+        """Teleports a model (its model frame to `pose`, world frame) and sets its velocity."""
+        values = list(pose.position) + list(pose.orientation) + list(linear) + list(angular)
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError("model state for '%s' has a non-finite value; nothing changed" % name)
+        norm = math.sqrt(sum(q * q for q in pose.orientation))
+        if norm < 1e-9:
+            raise ValueError("orientation of '%s' is a zero quaternion; nothing changed" % name)
+        pose = Pose(pose.position, tuple(q / norm for q in pose.orientation))
+        entity = self.entity(name)
+        for body, offset in zip(entity.body_ids, entity.link_offsets):
+            self._place(body, pose.compose(offset))
+            self.client.resetBaseVelocity(body, list(linear), list(angular))
+        if entity.robot is not None:
+            for index in entity.robot.joints.values():
+                self.client.resetJointState(entity.body_ids[0], index, 0.0, 0.0)
+
+    def delete_model(self, name):
+        entity = self.entity(name)
+        for body in entity.body_ids:
+            self.caster.remove_body(body)
+            self.client.removeBody(body)
+            self._body_owner.pop(body, None)
+        del self.entities[name]
+        self._touching = {pair for pair in self._touching if name not in pair}
+
+    def reset_world(self):
+        """Every model back to its initial pose at rest; components forget their commands.
+        Sim time goes on (Gazebo's reset_world)."""
+        for entity in self.entities.values():
+            self.set_model_state(entity.name, entity.initial_pose)
+            if entity.robot is not None:
+                for component in entity.robot.components:
+                    component.reset()
+        self._touching.clear()
+
+    def reset_simulation(self):
+        """reset_world, and sim time back to 0 (Gazebo's reset_simulation)."""
+        self.reset_world()
+        self.step_count = 0
+        self.rng = np.random.default_rng(self.seed)
+        for robot in self.robots():
+            for component in robot.components:
+                if hasattr(component, "rng"):
+                    component.rng = self.rng
+
+    # --- spawning -----------------------------------------------------------------------
+    def spawn_urdf(self, name: str, urdf_xml: str, pose: Pose, namespace: str = "") -> Robot:
+        """Loads a URDF robot at `pose` (its root link frame, world) with the components its
+        `<gazebo>` tags ask for. Raises SpawnError (world unchanged) when it cannot."""
+        if not name or not name.strip():
+            raise SpawnError("model name is empty; pass -model NAME")
+        if name in self.entities:
+            raise SpawnError("SpawnModel: Failure - entity already exists: model '%s' is in the "
+                             "world; delete it first or choose another -model name" % name)
+        values = list(pose.position) + list(pose.orientation)
+        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
+            raise SpawnError("spawn pose of '%s' is not finite: %s; pass numbers for -x -y -z"
+                             % (name, values))
+        try:
+            spec = parse_robot(urdf_xml, name)
+        except Exception as err:   # the parser names what is wrong with the description
+            raise SpawnError("model '%s': %s" % (name, err))
+        body = self._load_urdf(name, strip_for_bullet(urdf_xml), pose)
+        try:
+            robot = self._make_robot(name, body, spec, pose, namespace)
+            inside = self._overlapping_models(body)
+            if inside:
+                raise SpawnError("spawn pose (%.3f, %.3f, %.3f) puts '%s' inside %s; choose a "
+                                 "free pose" % (pose.position + (name, ", ".join(inside))))
+        except Exception:
+            self.client.removeBody(body)
+            raise
+        for message in spec.warnings:
+            self.warn("model '%s': %s" % (name, message))
+        self.entities[name] = Entity(name, [body], [Pose()], pose, static=False, robot=robot)
+        self._body_owner[body] = name
+        self.caster.add_body(body, static=False)
+        return robot
+
+    def _load_urdf(self, name, urdf_text, pose):
+        handle, path = tempfile.mkstemp(prefix="pybullet_gazebo_%s_" % name, suffix=".urdf")
+        try:
+            with os.fdopen(handle, "w") as out:
+                out.write(urdf_text)
+            flags = pybullet.URDF_USE_INERTIA_FROM_FILE
+            try:
+                body = self.client.loadURDF(path, basePosition=pose.position,
+                                            baseOrientation=pose.orientation, flags=flags)
+            except pybullet.error as err:
+                raise SpawnError("model '%s': Bullet could not load the URDF (%s); check the "
+                                 "description with check_urdf or xacro" % (name, err))
+        finally:
+            os.unlink(path)
+        return body
+
+    def _make_robot(self, name, body, spec, pose, namespace) -> Robot:
+        client = self.client
+        joints, links = {}, {spec.root_link: -1}
+        for index in range(client.getNumJoints(body)):
+            info = client.getJointInfo(body, index)
+            joints[info[1].decode()] = index
+            links[info[12].decode()] = index
+            # Bullet motorises every joint by default; Gazebo's joints are free until a
+            # plugin drives them.
+            client.setJointMotorControl2(body, index, pybullet.VELOCITY_CONTROL, force=0.0)
+        friction = effective_link_friction(spec)      # Bullet's friction is per link
+        for link, index in links.items():
+            client.changeDynamics(body, index, lateralFriction=friction.get(link, (DEFAULT_MU,))[0])
+        robot = Robot(name, body, namespace, joints, links, pose)
+        for plugin in spec.plugins:
+            component_class = PLUGINS.get(plugin.filename)
+            if component_class is None:
+                self.warn("model '%s': plugin '%s' (%s) is not simulated by the stand-in; "
+                          "ignored" % (name, plugin.name, plugin.filename))
+                continue
+            robot.components.append(component_class(
+                client, body, joints, plugin, warn=lambda m: self.warn("model '%s': %s" % (name, m)),
+                command_timeout=self.command_timeout))
+        for sensor in spec.sensors:
+            if sensor.link not in links:
+                raise SpawnError("model '%s': sensor '%s' is on link '%s', which the URDF does "
+                                 "not have" % (name, sensor.name, sensor.link))
+            if sensor.plugin is not None and sensor.plugin.filename not in SENSOR_PLUGINS:
+                self.warn("model '%s': sensor plugin '%s' is not simulated by the stand-in; "
+                          "sensor '%s' publishes nothing" % (name, sensor.plugin.filename, sensor.name))
+                continue
+            robot.components.append(SENSORS["ray"](client, body, links[sensor.link], sensor,
+                                                   self.caster, self.rng))
+        return robot
+
+    def _overlapping_models(self, body) -> List[str]:
+        """Names of the models (the ground excluded) the body penetrates."""
+        self.client.performCollisionDetection()
+        names = set()
+        for other_body, owner in self._body_owner.items():
+            if self.entities[owner].is_ground:
+                continue
+            for point in self.client.getClosestPoints(body, other_body, distance=0.0):
+                if point[8] < -0.001:      # contact distance [m]; negative = penetration
+                    names.add(owner)
+        return sorted(names)
+
+    def positive_turn_direction(self, robot) -> Optional[str]:
+        """'clockwise' or 'counter-clockwise': which way a positive angular.z turns the robot
+        seen from above, given where the drive's named joints really are. None without a drive.
+
+        gazebo_ros_diff_drive gives the joint *named* by rightJoint the faster wheel for a
+        positive angular.z, whatever side it is on; if it sits on the robot's left (+y), the
+        robot turns clockwise."""
+        for component in robot.components:
+            if not hasattr(component, "right_joint"):
+                continue
+            root = self.model_pose(robot.name)
+            def lateral(joint):
+                world_position = self.client.getLinkState(
+                    robot.body_id, robot.joints[joint], computeForwardKinematics=True)[4]
+                return root.inverse().transform_point(world_position)[1]
+            faster_on_left = lateral(component.right_joint) > lateral(component.left_joint)
+            if getattr(component, "legacy_mode", False):
+                faster_on_left = not faster_on_left
+            return "clockwise" if faster_on_left else "counter-clockwise"
+        return None
+
+    # --- contacts -----------------------------------------------------------------------
+    def _track_contacts(self, robots):
+        touching = set()
+        for robot in robots:
+            for point in self.client.getContactPoints(bodyA=robot.body_id):
+                owner = self._body_owner.get(point[2])
+                if owner is None or owner == robot.name or self.entities[owner].is_ground:
+                    continue
+                touching.add((robot.name, owner))
+        for pair in sorted(touching - self._touching):
+            self.contact_events.append(ContactEvent(self.sim_time, *pair))
+        self._touching = touching
+
+    def touching(self):
+        """(robot, other model) pairs in contact after the last step."""
+        return sorted(self._touching)
+
+    # --- building world models ------------------------------------------------------------
+    def _add_world_model(self, model):
+        bodies, offsets = [], []
+        all_planes = True
+        for link in model.links:
+            collisions = [c for c in link.collisions if not isinstance(c.geometry, Mesh)]
+            if not collisions:
+                continue
+            all_planes &= all(isinstance(c.geometry, Plane) for c in collisions)
+            body = self._create_link_body(model, link, collisions)
+            bodies.append(body)
+            offsets.append(link.pose)
+        if not bodies:
+            self.warn("model '%s' has no collision the stand-in can simulate; it is not in the "
+                      "physics world" % model.name)
+            return
+        entity = Entity(model.name, bodies, offsets, model.pose, model.static, is_ground=all_planes)
+        self.entities[model.name] = entity
+        for body in bodies:
+            self._body_owner[body] = model.name
+            if not all_planes:
+                self.caster.add_body(body, static=model.static)
+
+    def _create_link_body(self, model, link, collisions):
+        client = self.client
+        if len(collisions) == 1 and isinstance(collisions[0].geometry, Plane):
+            shape = client.createCollisionShape(pybullet.GEOM_PLANE,
+                                                planeNormal=collisions[0].geometry.normal)
+        else:
+            kwargs = dict(shapeTypes=[], radii=[], halfExtents=[], lengths=[], planeNormals=[],
+                          collisionFramePositions=[], collisionFrameOrientations=[])
+            for collision in collisions:
+                self._append_shape(kwargs, collision)
+            shape = client.createCollisionShapeArray(**kwargs)
+        world_pose = model.pose.compose(link.pose)
+        inertial = link.inertial
+        mass = 0.0 if model.static else inertial.mass
+        body = client.createMultiBody(
+            baseMass=mass, baseCollisionShapeIndex=shape,
+            basePosition=world_pose.position, baseOrientation=world_pose.orientation,
+            baseInertialFramePosition=inertial.pose.position,
+            baseInertialFrameOrientation=inertial.pose.orientation)
+        if mass > 0.0:
+            client.changeDynamics(body, -1, localInertiaDiagonal=list(inertial.inertia))
+        client.changeDynamics(body, -1, lateralFriction=collisions[0].mu)
+        return body
+
+    @staticmethod
+    def _append_shape(kwargs, collision):
+        geometry = collision.geometry
+        radius, half, length, normal = 0.0, [0.0, 0.0, 0.0], 0.0, [0.0, 0.0, 1.0]
+        if isinstance(geometry, Box):
+            kind, half = pybullet.GEOM_BOX, [s / 2.0 for s in geometry.size]
+        elif isinstance(geometry, Cylinder):
+            kind, radius, length = pybullet.GEOM_CYLINDER, geometry.radius, geometry.length
+        elif isinstance(geometry, Sphere):
+            kind, radius = pybullet.GEOM_SPHERE, geometry.radius
+        elif isinstance(geometry, Plane):
+            kind, normal = pybullet.GEOM_PLANE, list(geometry.normal)
+        else:
+            raise ValueError("collision '%s': geometry %r is not supported"
+                             % (collision.name, geometry))
+        kwargs["shapeTypes"].append(kind)
+        kwargs["radii"].append(radius)
+        kwargs["halfExtents"].append(half)
+        kwargs["lengths"].append(length)
+        kwargs["planeNormals"].append(normal)
+        kwargs["collisionFramePositions"].append(list(collision.pose.position))
+        kwargs["collisionFrameOrientations"].append(list(collision.pose.orientation))
+
+    # --- frames -------------------------------------------------------------------------
+    def _link_frame(self, body) -> Pose:
+        """World pose of a body's base link frame (Bullet reports its inertial frame)."""
+        position, orientation = self.client.getBasePositionAndOrientation(body)
+        local_position, local_orientation = self.client.getDynamicsInfo(body, -1)[3:5]
+        inertial = Pose(tuple(position), tuple(orientation))
+        return inertial.compose(Pose(tuple(local_position), tuple(local_orientation)).inverse())
+
+    def _place(self, body, link_pose: Pose):
+        local_position, local_orientation = self.client.getDynamicsInfo(body, -1)[3:5]
+        inertial = link_pose.compose(Pose(tuple(local_position), tuple(local_orientation)))
+        self.client.resetBasePositionAndOrientation(body, inertial.position, inertial.orientation)

@@ -1,0 +1,67 @@
+"""Engine data <-> ROS messages. Every message of one step carries the same stamp."""
+import math
+
+import rospy
+from geometry_msgs.msg import Point, Pose as PoseMsg, Quaternion, TransformStamped, Twist, Vector3
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
+
+from pybullet_gazebo.engine.transforms import Pose
+
+
+def stamp_of(step_count, step_size):
+    """rospy.Time of a step, computed in integer nanoseconds so it never drifts."""
+    step_ns = int(round(step_size * 1e9))
+    total = step_count * step_ns
+    return rospy.Time(total // 1000000000, total % 1000000000)
+
+
+def pose_to_msg(pose):
+    return PoseMsg(Point(*pose.position), Quaternion(*pose.orientation))
+
+
+def pose_from_msg(msg, zero_quaternion_is_identity=False):
+    q = (msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w)
+    if zero_quaternion_is_identity and all(v == 0.0 for v in q):
+        q = (0.0, 0.0, 0.0, 1.0)
+    return Pose((msg.position.x, msg.position.y, msg.position.z), q)
+
+
+def twist_to_msg(linear, angular):
+    return Twist(Vector3(*[float(v) for v in linear]), Vector3(*[float(v) for v in angular]))
+
+
+def is_finite_twist(msg):
+    values = (msg.linear.x, msg.linear.y, msg.linear.z, msg.angular.x, msg.angular.y, msg.angular.z)
+    return all(math.isfinite(v) for v in values)
+
+
+def scan_to_msg(scan, stamp):
+    msg = LaserScan()
+    msg.header.stamp = stamp
+    msg.header.frame_id = scan.frame_id
+    msg.angle_min = scan.angle_min
+    msg.angle_max = scan.angle_max
+    msg.angle_increment = scan.angle_increment
+    msg.time_increment = scan.time_increment
+    msg.scan_time = scan.scan_time
+    msg.range_min = scan.range_min
+    msg.range_max = scan.range_max
+    msg.ranges = scan.ranges.tolist()
+    return msg
+
+
+def odometry_to_msgs(odometry, drive, stamp):
+    """(nav_msgs/Odometry, TransformStamped odom -> base) as gazebo_ros_diff_drive sends."""
+    msg = Odometry()
+    msg.header.stamp = stamp
+    msg.header.frame_id = drive.odometry_frame
+    msg.child_frame_id = drive.robot_base_frame
+    msg.pose.pose = pose_to_msg(odometry.pose)
+    msg.twist.twist = twist_to_msg(odometry.linear, odometry.angular)
+    transform = TransformStamped()
+    transform.header = msg.header
+    transform.child_frame_id = drive.robot_base_frame
+    transform.transform.translation = Vector3(*odometry.pose.position)
+    transform.transform.rotation = Quaternion(*odometry.pose.orientation)
+    return msg, transform
