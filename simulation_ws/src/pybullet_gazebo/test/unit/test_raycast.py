@@ -265,6 +265,49 @@ def test_many_random_shapes_static_and_dynamic(client):
     assert close > 0.5
 
 
+def test_fan_of_coplanar_rays_matches_rays_cast_one_by_one(client):
+    """A laser's rays share a plane, which lets the caster pair each shape only with the rays
+    inside the angle it spans; a lone ray takes the general path. Both must agree, also for
+    full circles (angles wrapping past +-pi) and shapes whose projection holds the origin."""
+    rng = np.random.default_rng(4)
+    scene = Scene(client)
+    caster = RayCaster(client)
+    origin = np.array([0.0, 0.0, 0.2])
+    # a slab tilted 45 deg right above the origin: it crosses the tilted planes below and its
+    # projection on them contains the origin
+    slab = scene.add("box", (1.0, 0.6, 0.05), position=(0.0, 0.0, 0.9),
+                     orientation=Pose.from_xyz_rpy(roll=0.8).orientation)
+    caster.add_body(slab, static=True)
+    for i in range(40):
+        geometry, _ = PRIMITIVES[i % 4]
+        dims = {"box": tuple(rng.uniform(0.05, 0.8, 3)), "sphere": rng.uniform(0.05, 0.8),
+                "cylinder": (rng.uniform(0.05, 0.6), rng.uniform(0.1, 2.0)),
+                "capsule": (rng.uniform(0.05, 0.6), rng.uniform(0.1, 2.0))}[geometry]
+        position = rng.uniform(-6, 6, 3) * (1, 1, 0.2)
+        if np.linalg.norm(position - origin) < 2.5:
+            continue
+        body = scene.add(geometry, dims, position=position, orientation=random_quaternion(rng))
+        caster.add_body(body, static=True)
+    for roll, pitch, yaw, first, span in [(0, 0, 0, -math.pi / 2, math.pi),
+                                          (0, 0, 0, 0.3, 2 * math.pi),
+                                          (0.5, -0.3, 1.0, -2.0, 2 * math.pi),
+                                          (1.2, 0.2, 0.0, 2.5, 2.0)]:
+        plane = Pose.from_xyz_rpy(0, 0, 0, roll, pitch, yaw).matrix
+        angles = first + np.linspace(0.0, span, 1441)
+        fan = np.stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)], axis=1) @ plane.T
+        together = caster.cast(origin, fan, 0.1, 10.0)
+        one_by_one = np.array([caster.cast(origin, d[None], 0.1, 10.0)[0] for d in fan])
+        np.testing.assert_array_equal(np.isfinite(together), np.isfinite(one_by_one))
+        hit = np.isfinite(together)
+        assert 20 <= hit.sum() < len(fan)
+        np.testing.assert_allclose(together[hit], one_by_one[hit], rtol=0, atol=1e-12)
+        assert np.max(np.abs(scene.sdf(origin + together[hit, None] * fan[hit]))) < EXACT
+    # straight up, the ray runs along the slab's centre line: it enters the lower face
+    # 0.05 / cos(0.8) before the centre, 0.7 m above the origin
+    up = caster.cast(origin, [(0.0, 0.0, 1.0), (1.0, 0.0, 0.0)], 0.1, 10.0)
+    assert up[0] == pytest.approx(0.7 - 0.05 / math.cos(0.8), abs=EXACT)
+
+
 def test_urdf_links_inertial_frames_and_several_collisions(client, tmp_path):
     """Shapes of a multi-link URDF (turned inertial frames, two collisions on one link,
     an implicit cylinder, a capsule) against geometry computed from the URDF's own frames."""
@@ -291,7 +334,8 @@ def test_urdf_links_inertial_frames_and_several_collisions(client, tmp_path):
    <geometry><capsule radius="0.05" length="0.2"/></geometry></collision>
  </link>
  <joint name="j_mast" type="revolute"><parent link="base"/><child link="mast"/>
-  <origin xyz="0.2 0 0.04"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <origin xyz="0.2 0 0.04"/><axis xyz="1 0 0"/>
+  <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
 </robot>""")
     body = client.loadURDF(str(urdf), basePosition=(1.0, 0.5, 0.3),
                            baseOrientation=Pose.from_xyz_rpy(yaw=0.4, pitch=0.2).orientation,
@@ -311,7 +355,8 @@ def test_urdf_links_inertial_frames_and_several_collisions(client, tmp_path):
     for link, origin, sdf in [
             (0, Pose(), lambda x: sdf_box(x, np.array([0.25, 0.15, 0.035]))),
             (0, Pose((0.35, 0, -0.05)), lambda x: sdf_sphere(x, 0.05)),
-            (1, Pose.from_xyz_rpy(0, 0, 0, 0, 1.5707, 1.5707), lambda x: sdf_cylinder(x, 0.1, 0.04)),
+            (1, Pose.from_xyz_rpy(0, 0, 0, 0, 1.5707, 1.5707),
+             lambda x: sdf_cylinder(x, 0.1, 0.04)),
             (2, Pose.from_xyz_rpy(0, 0, 0.1, 0.3, 0, 0), lambda x: sdf_capsule(x, 0.05, 0.2))]:
         scene.parts.append((body, links[link].compose(origin), sdf, False))
     rng = np.random.default_rng(2)

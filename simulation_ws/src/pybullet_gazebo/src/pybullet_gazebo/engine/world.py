@@ -11,11 +11,13 @@ from dataclasses import dataclass, field
 import math
 import os
 import tempfile
+import xml.etree.ElementTree as ET
 from typing import Callable, Dict, List, Optional
 
 import numpy as np
 import pybullet
 
+from . import wheel_contact
 from .raycast import RayCaster
 from .registry import PLUGINS, SENSOR_PLUGINS, SENSORS
 from .robot_description import DEFAULT_MU, effective_link_friction, parse_robot, strip_for_bullet
@@ -96,7 +98,9 @@ class World:
 
         client.resetSimulation()
         client.setGravity(*spec.physics.gravity)
-        client.setPhysicsEngineParameter(fixedTimeStep=step_size, numSubSteps=1)
+        # collision groups filter with AND, Bullet's own rule (see wheel_contact)
+        client.setPhysicsEngineParameter(fixedTimeStep=step_size, numSubSteps=1,
+                                         collisionFilterMode=0)
         for message in spec.warnings:
             warn(message)
         for model in spec.models:
@@ -219,9 +223,12 @@ class World:
             spec = parse_robot(urdf_xml, name)
         except Exception as err:   # the parser names what is wrong with the description
             raise SpawnError("model '%s': %s" % (name, err))
-        body = self._load_urdf(name, strip_for_bullet(urdf_xml), pose)
+        urdf_text, contacts = wheel_contact.add_contact_links(
+            strip_for_bullet(urdf_xml), self._driven_wheel_links(urdf_xml, spec))
+        body = self._load_urdf(name, urdf_text, pose)
         try:
             robot = self._make_robot(name, body, spec, pose, namespace)
+            wheel_contact.apply_groups(self.client, body, robot.links, contacts)
             inside = self._overlapping_models(body)
             if inside:
                 raise SpawnError("spawn pose (%.3f, %.3f, %.3f) puts '%s' inside %s; choose a "
@@ -236,12 +243,23 @@ class World:
         self.caster.add_body(body, static=False)
         return robot
 
+    @staticmethod
+    def _driven_wheel_links(urdf_xml, spec):
+        """Child links of the joints the robot's drive plugins name."""
+        joint_names = {value for plugin in spec.plugins if plugin.filename in PLUGINS
+                       for key, value in plugin.params.items() if key in ("leftJoint", "rightJoint")}
+        root = ET.fromstring(urdf_xml)
+        return {joint.find("child").get("link") for joint in root.findall("joint")
+                if joint.get("name") in joint_names and joint.find("child") is not None}
+
     def _load_urdf(self, name, urdf_text, pose):
         handle, path = tempfile.mkstemp(prefix="pybullet_gazebo_%s_" % name, suffix=".urdf")
         try:
             with os.fdopen(handle, "w") as out:
                 out.write(urdf_text)
-            flags = pybullet.URDF_USE_INERTIA_FROM_FILE
+            # inertia as written (not recomputed from the shapes); cylinders as true
+            # cylinders, not convex hulls (smooth wheel contact; the ray caster reads them)
+            flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
             try:
                 body = self.client.loadURDF(path, basePosition=pose.position,
                                             baseOrientation=pose.orientation, flags=flags)
@@ -357,7 +375,9 @@ class World:
         self.entities[model.name] = entity
         for body in bodies:
             self._body_owner[body] = model.name
-            if not all_planes:
+            if all_planes:
+                wheel_contact.mark_ground(self.client, body)
+            else:
                 self.caster.add_body(body, static=model.static)
 
     def _create_link_body(self, model, link, collisions):
@@ -380,7 +400,9 @@ class World:
             baseInertialFramePosition=inertial.pose.position,
             baseInertialFrameOrientation=inertial.pose.orientation)
         if mass > 0.0:
-            client.changeDynamics(body, -1, localInertiaDiagonal=list(inertial.inertia))
+            # Gazebo lets resting bodies sleep (auto-disable); so does Bullet, when asked
+            client.changeDynamics(body, -1, localInertiaDiagonal=list(inertial.inertia),
+                                  activationState=pybullet.ACTIVATION_STATE_ENABLE_SLEEPING)
         client.changeDynamics(body, -1, lateralFriction=collisions[0].mu)
         return body
 

@@ -1,0 +1,296 @@
+"""gazebo_ros_diff_drive (ROS Noetic) as an engine component: two wheel joints driven as
+Bullet velocity motors from a (linear.x, angular.z) command, and odometry.
+
+Plugin parameters, read as Noetic reads them (default in brackets):
+  leftJoint [left_joint], rightJoint [right_joint]  joint names
+  wheelDiameter [0.15 m], wheelSeparation [0.34 m]
+  wheelTorque [5 N m]        motor force limit. The tag `torque` of older releases is NOT
+                             read by Noetic: when only `torque` is given, a warning says so
+                             and 5 N m is used, as in Gazebo.
+  wheelAcceleration [0 = no limit, m/s^2 of wheel rim speed]
+  updateRate [100 Hz; <= 0 = every step]  wheel targets and odometry are updated at this
+                             rate of sim time
+  commandTopic [cmd_vel], odometryTopic [odom], odometryFrame [odom],
+  robotBaseFrame [base_footprint], odometrySource [world | encoder]
+  publishTf [true]           false: Noetic publishes no odometry at all (due() stays false)
+  publishOdomTF [true], publishWheelTF [false], publishWheelJointState [false]
+  legacyMode                 removed in Melodic (gazebo_ros_pkgs #707) and not read by Noetic:
+                             `true` only draws a warning, unless the component is built with
+                             legacy_mode_swaps=True to emulate Kinetic and older, where
+                             legacyMode true swapped the two wheels' formulas.
+
+Wheel speeds for a command (v [m/s], w [rad/s]): the joint NAMED by leftJoint turns at
+(v - w * separation / 2) / radius and the joint named by rightJoint at
+(v + w * separation / 2) / radius [rad/s], whatever side of the robot they are on (for m2wr,
+whose "right" joint sits on its left, a positive w turns the robot clockwise, as in Gazebo).
+A speed above the joint's URDF velocity limit is clamped to it. The last command is held for
+ever, as in Gazebo, unless command_timeout [s of sim time] > 0. Unlike Gazebo, a command with
+a non-finite value is refused (set_command returns False) and the previous one kept.
+
+Odometry (odometrySource world): the true pose of the base link frame in the world and its
+velocity, linear (of the link frame's origin) and angular, both expressed in the base link
+frame (Noetic rotates by yaw only; on flat ground the two agree). odometrySource encoder
+integrates the wheel joints' speeds as Noetic does (planar pose, heading from the wheels).
+"""
+from dataclasses import dataclass
+import math
+
+import numpy as np
+import pybullet
+
+from .transforms import Pose
+
+_TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
+
+
+@dataclass
+class Odometry:
+    """What a nav_msgs/Odometry carries, without ROS."""
+    pose: Pose                  # base link frame in the odometry frame (the world) [m]
+    linear: np.ndarray          # (3,) [m/s], in the base link frame
+    angular: np.ndarray         # (3,) [rad/s], in the base link frame
+
+
+class _Cadence:
+    """Noetic's update timing: due once `period` [s] of sim time has passed since the last
+    update; the schedule advances by whole periods (and restarts after a reset or a lag)."""
+
+    def __init__(self, period):
+        self.period = period
+        self.last = None
+
+    def take(self, sim_time):
+        """True (and the update is counted) when an update is due at sim_time."""
+        if self.last is None or sim_time < self.last:
+            self.last = sim_time
+            return True
+        if sim_time - self.last < self.period - _TOLERANCE:
+            return False
+        self.last += self.period
+        if sim_time - self.last >= self.period - _TOLERANCE:
+            self.last = sim_time
+        return True
+
+
+class DiffDrive:
+    """A differential drive on two joints of a body."""
+
+    KEY = "libgazebo_ros_diff_drive.so"
+
+    def __init__(self, client, body_id, joints, plugin, warn, command_timeout=0.0,
+                 legacy_mode_swaps=False):
+        self._client = client
+        self.body_id = body_id
+        self._warn = warn
+        self._warned = set()
+        self.name = plugin.name
+        params = dict(plugin.params)
+        where = "diff drive plugin '%s' (%s)" % (plugin.name, plugin.filename)
+
+        def text(tag, default):
+            value = params.get(tag)
+            return default if value is None else value.strip()
+
+        def number(tag, default, minimum=None, above=None):
+            raw = params.get(tag)
+            if raw is None:
+                return default
+            try:
+                value = float(raw)
+            except ValueError:
+                raise ValueError("%s: <%s> is '%s', not a number" % (where, tag, raw))
+            if not math.isfinite(value):
+                raise ValueError("%s: <%s> is '%s'; give a finite number" % (where, tag, raw))
+            if minimum is not None and value < minimum:
+                raise ValueError("%s: <%s> is %s; it must be >= %s" % (where, tag, raw, minimum))
+            if above is not None and value <= above:
+                raise ValueError("%s: <%s> is %s; it must be > %s" % (where, tag, raw, above))
+            return value
+
+        def boolean(tag, default):
+            raw = params.get(tag)
+            if raw is None:
+                return default
+            value = raw.strip().lower()
+            if value in ("true", "1"):
+                return True
+            if value in ("false", "0"):
+                return False
+            raise ValueError("%s: <%s> is '%s'; write true or false" % (where, tag, raw))
+
+        self.command_topic = text("commandTopic", "cmd_vel")
+        self.odometry_topic = text("odometryTopic", "odom")
+        self.odometry_frame = text("odometryFrame", "odom")
+        self.robot_base_frame = text("robotBaseFrame", "base_footprint")
+        self.publish_tf = boolean("publishTf", True)
+        self.publish_wheel_tf = boolean("publishWheelTF", False)
+        self.publish_odom_tf = boolean("publishOdomTF", True)
+        self.publish_wheel_joint_state = boolean("publishWheelJointState", False)
+        self.wheel_separation = number("wheelSeparation", 0.34, above=0.0)          # [m]
+        self.wheel_diameter = number("wheelDiameter", 0.15, above=0.0)              # [m]
+        self.wheel_radius = self.wheel_diameter / 2.0                                # [m]
+        self.wheel_acceleration = number("wheelAcceleration", 0.0, minimum=0.0)     # [m/s^2]
+        self.wheel_torque = number("wheelTorque", 5.0, minimum=0.0)                 # [N m]
+        self.update_rate = number("updateRate", 100.0)                              # [Hz]
+        for tag in ("wheelSeparation", "wheelDiameter"):
+            if tag not in params:
+                self._warn_once("%s: <%s> missing; Noetic's default %s m is used"
+                                % (where, tag, {"wheelSeparation": 0.34,
+                                                "wheelDiameter": 0.15}[tag]))
+        if "torque" in params and "wheelTorque" not in params:
+            self._warn_once("%s: <torque>%s</torque> is not read by ROS Noetic's "
+                            "gazebo_ros_diff_drive (the tag is <wheelTorque>); the wheels get "
+                            "Noetic's default 5 N m, as in Gazebo"
+                            % (where, params["torque"].strip()))
+        self.odometry_source = text("odometrySource", "world")
+        if self.odometry_source not in ("world", "encoder"):
+            self._warn_once("%s: <odometrySource> '%s' is neither world nor encoder; world is "
+                            "used" % (where, self.odometry_source))
+            self.odometry_source = "world"
+        legacy = boolean("legacyMode", False)
+        self.legacy_mode = bool(legacy and legacy_mode_swaps)    # whether the wheels swap
+        if legacy and not legacy_mode_swaps:
+            self._warn_once("%s: <legacyMode>true is ignored, as ROS Noetic ignores it (removed "
+                            "in Melodic): leftJoint gets (v - w*sep/2)/r and rightJoint "
+                            "(v + w*sep/2)/r" % where)
+
+        self.left_joint = text("leftJoint", "left_joint")
+        self.right_joint = text("rightJoint", "right_joint")
+        self._joints = []                                 # (index, name, velocity limit)
+        for tag, name in (("leftJoint", self.left_joint), ("rightJoint", self.right_joint)):
+            if name not in joints:
+                raise ValueError("%s: <%s> names joint '%s', which the model does not have; its "
+                                 "joints are: %s" % (where, tag, name,
+                                                     ", ".join(sorted(joints)) or "(none)"))
+            index = joints[name]
+            limit = client.getJointInfo(body_id, index)[11]      # URDF <limit velocity>
+            self._joints.append((index, name, limit if limit > 0 else math.inf))
+
+        self.command_timeout = float(command_timeout)             # [s]; 0 = hold for ever
+        period = 1.0 / self.update_rate if self.update_rate > 0 else 0.0   # [s]
+        self._control = _Cadence(period)
+        self._publish = _Cadence(period)
+        base = client.getDynamicsInfo(body_id, -1)
+        self._base_inertial = Pose(base[3], base[4])   # centre of mass in the base link frame
+        self.reset()
+
+    # --- commands ---------------------------------------------------------------------------
+    def set_command(self, linear_x, angular_z):
+        """Takes a cmd_vel (linear.x [m/s], angular.z [rad/s]). Returns False, keeping the
+        previous command, when a value is not a finite number."""
+        try:
+            v, w = float(linear_x), float(angular_z)
+        except (TypeError, ValueError):
+            v = w = math.nan
+        if not (math.isfinite(v) and math.isfinite(w)):
+            self._warn_once("non-finite", "diff drive '%s': ignored a %s command with a "
+                            "non-finite value (%s, %s); the previous command stays (reported "
+                            "once)" % (self.name, self.command_topic, linear_x, angular_z))
+            return False
+        self.command = (v, w)
+        self._fresh = True
+        return True
+
+    def wheel_speeds(self, linear_x, angular_z):
+        """Target speeds [rad/s] of (leftJoint, rightJoint) for a command, before clamping."""
+        half = angular_z * self.wheel_separation / 2.0
+        left = (linear_x - half) / self.wheel_radius
+        right = (linear_x + half) / self.wheel_radius
+        return (right, left) if self.legacy_mode else (left, right)
+
+    def reset(self):
+        """Simulation reset: no command, wheels told to stop, timers and encoder restarted."""
+        self.command = (0.0, 0.0)
+        self._fresh = False
+        self._command_time = None
+        self._control.last = None
+        self._publish.last = None
+        self._rim_speed = [0.0, 0.0]                       # [m/s] last applied, per wheel
+        self._encoder = [0.0, 0.0, 0.0]                    # x [m], y [m], heading [rad]
+        self._encoder_twist = (0.0, 0.0)                   # [m/s], [rad/s]
+        self._encoder_time = None
+        self._apply(0.0, 0.0)
+
+    # --- stepping ---------------------------------------------------------------------------
+    def before_step(self, sim_time, dt):
+        """Called before each physics step at sim_time [s]; dt [s] is the step."""
+        if self._fresh:
+            self._command_time = sim_time
+            self._fresh = False
+        if self.odometry_source == "encoder":
+            self._integrate_encoder(sim_time)
+        previous = self._control.last
+        if not self._control.take(sim_time):
+            return
+        elapsed = sim_time - previous if previous is not None and sim_time > previous else dt
+        v, w = self.command
+        if self.command_timeout > 0 and (self._command_time is None or
+                                         sim_time - self._command_time > self.command_timeout):
+            v, w = 0.0, 0.0
+        targets = [s * self.wheel_radius for s in self.wheel_speeds(v, w)]   # [m/s]
+        for i, target in enumerate(targets):
+            if self.wheel_acceleration > 0:
+                step = self.wheel_acceleration * elapsed
+                target = min(max(target, self._rim_speed[i] - step), self._rim_speed[i] + step)
+            self._rim_speed[i] = target
+        self._apply(self._rim_speed[0] / self.wheel_radius, self._rim_speed[1] / self.wheel_radius)
+
+    def _apply(self, left, right):
+        """Drive (leftJoint, rightJoint) at these speeds [rad/s], within their limits."""
+        for (index, name, limit), speed in zip(self._joints, (left, right)):
+            if abs(speed) > limit:
+                self._warn_once(("clamped", name),
+                                "diff drive '%s': wheel speed %.4g rad/s for joint '%s' is over "
+                                "its URDF velocity limit %.4g rad/s; clamped (reported once)"
+                                % (self.name, speed, name, limit))
+                speed = math.copysign(limit, speed)
+            self._client.setJointMotorControl2(self.body_id, index, pybullet.VELOCITY_CONTROL,
+                                               targetVelocity=speed, force=self.wheel_torque)
+
+    def _integrate_encoder(self, sim_time):
+        """Noetic's encoder odometry: dead reckoning from the wheel joints' speeds."""
+        if self._encoder_time is None or sim_time <= self._encoder_time:
+            self._encoder_time = sim_time
+            return
+        elapsed = sim_time - self._encoder_time
+        self._encoder_time = sim_time
+        left, right = (self._client.getJointState(self.body_id, index)[1]
+                       for index, _, _ in self._joints)
+        s_left = left * self.wheel_radius * elapsed
+        s_right = right * self.wheel_radius * elapsed
+        s_sum, s_diff = s_left + s_right, s_right - s_left
+        heading = self._encoder[2] + s_diff / (2.0 * self.wheel_separation)
+        dx, dy = s_sum / 2.0 * math.cos(heading), s_sum / 2.0 * math.sin(heading)
+        dtheta = s_diff / self.wheel_separation
+        self._encoder = [self._encoder[0] + dx, self._encoder[1] + dy, self._encoder[2] + dtheta]
+        speed = math.hypot(dx, dy) / elapsed
+        self._encoder_twist = (-speed if s_sum < 0 else speed, dtheta / elapsed)
+
+    # --- odometry ---------------------------------------------------------------------------
+    def due(self, sim_time):
+        """True once per 1/updateRate [s] of sim time (each true answer starts the next
+        period); always false when publishTf is false, as Noetic then publishes nothing."""
+        return self.publish_tf and self._publish.take(sim_time)
+
+    def odometry(self):
+        """Odometry of the base link now (see the module docstring)."""
+        if self.odometry_source == "encoder":
+            x, y, heading = self._encoder
+            return Odometry(Pose.from_xyz_rpy(x, y, 0.0, 0.0, 0.0, heading),
+                            np.array([self._encoder_twist[0], 0.0, 0.0]),
+                            np.array([0.0, 0.0, self._encoder_twist[1]]))
+        client = self._client
+        com_position, com_orientation = client.getBasePositionAndOrientation(self.body_id)
+        link = Pose(com_position, com_orientation).compose(self._base_inertial.inverse())
+        linear, angular = (np.asarray(v, dtype=float)
+                           for v in client.getBaseVelocity(self.body_id))
+        # velocity of the link frame's origin, from the centre of mass's
+        linear = linear + np.cross(angular, np.asarray(link.position) - np.asarray(com_position))
+        to_base = link.matrix.T
+        return Odometry(link, to_base @ linear, to_base @ angular)
+
+    def _warn_once(self, key, message=None):
+        """Report `message` (default: the key itself) the first time `key` comes up."""
+        if key not in self._warned:
+            self._warned.add(key)
+            self._warn(key if message is None else message)

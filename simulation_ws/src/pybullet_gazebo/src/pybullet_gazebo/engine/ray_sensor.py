@@ -1,0 +1,128 @@
+"""Gazebo's `<sensor type="ray">` with its gazebo_ros_laser plugin, as an engine component.
+
+One horizontal fan of `samples` beams in the sensor frame's xy plane, from `min_angle`
+(index 0, the right-most beam) to `max_angle` [rad], angle_increment =
+(max_angle - min_angle) / (samples - 1). The sensor frame is the link's world pose composed
+with the sensor's `<pose>`. Each beam tests [range_min, range_max] [m] (like Gazebo's rays,
+which start at the minimum range) and never sees the robot's own body. No return is `+inf`
+(REP 117); Gaussian noise N(noise_mean, noise_stddev) [m] is added to returns only, drawn
+from the generator passed in (seedable), and a noisy return is kept inside
+[range_min, range_max] as Gazebo does.
+
+Plugin parameters read (libgazebo_ros_laser.so): `topicName` (Noetic's default "/world"),
+`frameName` (default: the sensor's link name; Noetic's own default is "/world"; a leading
+"/" is dropped, as tf does). The ROS adapter publishes `measure()`'s LaserScanData on
+`topic` with `frame_id`, stamped with the sim time passed in. Measurements are due at
+`update_rate` [Hz] of sim time (0 = every step).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .transforms import Pose
+
+_TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
+
+
+@dataclass
+class LaserScanData:
+    """What a sensor_msgs/LaserScan carries, without ROS."""
+    stamp: float                # sim time [s]
+    frame_id: str
+    angle_min: float            # [rad]
+    angle_max: float            # [rad]
+    angle_increment: float      # [rad]
+    time_increment: float       # [s], 0: all beams at once
+    scan_time: float            # [s] between scans
+    range_min: float            # [m]
+    range_max: float            # [m]
+    ranges: np.ndarray          # float32 (samples,) [m]; +inf where nothing is in range
+
+
+class RaySensor:
+    """A laser scanner on a link of a body."""
+
+    KEY = "ray"
+
+    def __init__(self, client, body_id, link_index, spec, caster, rng):
+        self._check(spec)
+        self._client = client
+        self.body_id = body_id
+        self.link_index = link_index
+        self.spec = spec
+        self._caster = caster
+        self.rng = rng                       # numpy Generator; the World may swap it on reset
+        params = spec.plugin.params if spec.plugin is not None else {}
+        self.topic = params.get("topicName", "/world").strip()
+        self.frame_id = params.get("frameName", spec.link).strip().lstrip("/")
+        self.update_rate = float(spec.update_rate)                   # [Hz]
+        self._period = 1.0 / self.update_rate if self.update_rate > 0 else 0.0   # [s]
+        samples = int(spec.samples)
+        self.angle_increment = ((spec.max_angle - spec.min_angle) / (samples - 1)
+                                if samples > 1 else 0.0)              # [rad]
+        angles = spec.min_angle + self.angle_increment * np.arange(samples)
+        self._beams = np.stack([np.cos(angles), np.sin(angles), np.zeros(samples)], axis=1)
+        if link_index == -1:
+            # pybullet reports the base's centre of mass; the link frame is offset from it
+            self._base_inertial = Pose(*client.getDynamicsInfo(body_id, -1)[3:5]).inverse()
+        self._last = None                                            # sim time of last scan
+
+    @staticmethod
+    def _check(spec):
+        where = "ray sensor '%s' on link '%s'" % (spec.name, spec.link)
+        if int(spec.samples) < 1:
+            raise ValueError("%s: <samples> is %s; it must be at least 1" % (where, spec.samples))
+        if not spec.max_angle >= spec.min_angle:
+            raise ValueError("%s: <max_angle> %s is below <min_angle> %s"
+                             % (where, spec.max_angle, spec.min_angle))
+        if not 0.0 <= spec.range_min < spec.range_max:
+            raise ValueError("%s: range must satisfy 0 <= <min> < <max>; got %s .. %s"
+                             % (where, spec.range_min, spec.range_max))
+        if not spec.update_rate >= 0.0:
+            raise ValueError("%s: <update_rate> %s must be >= 0 (0 = every step)"
+                             % (where, spec.update_rate))
+        if not spec.noise_stddev >= 0.0:
+            raise ValueError("%s: noise <stddev> %s must be >= 0" % (where, spec.noise_stddev))
+
+    def reset(self):
+        """After a simulation reset: the next call to due() is true."""
+        self._last = None
+
+    def due(self, sim_time):
+        """True when at least 1/update_rate [s] of sim time passed since the last scan (and on
+        the first call, and when the sim time went backwards)."""
+        if self._last is None or sim_time < self._last:
+            return True
+        return sim_time - self._last >= self._period - _TOLERANCE
+
+    def sensor_pose(self):
+        """World pose of the sensor frame: the link frame composed with the sensor's pose."""
+        client = self._client
+        if self.link_index == -1:
+            link = Pose(*client.getBasePositionAndOrientation(self.body_id)).compose(
+                self._base_inertial)
+        else:
+            state = client.getLinkState(self.body_id, self.link_index,
+                                        computeForwardKinematics=True)
+            link = Pose(state[4], state[5])
+        return link.compose(self.spec.pose)
+
+    def measure(self, sim_time):
+        """Scan now; returns a LaserScanData stamped `sim_time` [s]."""
+        spec = self.spec
+        pose = self.sensor_pose()
+        directions = self._beams @ pose.matrix.T
+        ranges = self._caster.cast(pose.position, directions, spec.range_min,
+                                   spec.range_max, exclude_body=self.body_id)
+        if spec.noise_stddev > 0.0 or spec.noise_mean != 0.0:
+            # one draw per beam whether it hit or not, so the stream does not depend on the scene
+            noise = self.rng.normal(spec.noise_mean, spec.noise_stddev, len(ranges))
+            hit = np.isfinite(ranges)
+            ranges[hit] = np.clip(ranges[hit] + noise[hit], spec.range_min, spec.range_max)
+        self._last = sim_time
+        return LaserScanData(
+            stamp=sim_time, frame_id=self.frame_id,
+            angle_min=float(spec.min_angle), angle_max=float(spec.max_angle),
+            angle_increment=float(self.angle_increment), time_increment=0.0,
+            scan_time=self._period, range_min=float(spec.range_min),
+            range_max=float(spec.range_max), ranges=ranges.astype(np.float32))

@@ -1,0 +1,67 @@
+"""Wheels that meet the ground at their mid-plane, as in Gazebo.
+
+A flat cylinder wheel standing on a plane touches it along a line. Gazebo's ODE puts a contact
+at each rim, so the wheel's grip acts at its mid-plane. Bullet keeps one contact at one rim
+edge and hops between edges: for m2wr (wheels 0.04 m wide, 0.3 m apart) the track width then
+jumps between 0.26 m and 0.34 m and a turn on the spot runs 13 % fast or slow.
+
+The fix keeps the wheel's own cylinder for everything but the ground, and adds to each driven
+wheel a fixed child link with a sphere of the wheel's radius that touches *only* the ground:
+its lowest point is the wheel's mid-plane contact. Collision groups (Bullet: two shapes touch
+when each one's group is in the other's mask):
+  ground          group GROUND, mask ALL
+  contact sphere  group CONTACT, mask GROUND
+  wheel cylinder  group 1, mask ALL but GROUND and CONTACT
+  everything else Bullet's defaults (dynamic: group 1, mask ALL; static: group 2, mask ALL
+                  but 2), which never include CONTACT in their group
+"""
+import xml.etree.ElementTree as ET
+
+DEFAULT = 1                    # Bullet's group of dynamic bodies
+GROUND, CONTACT = 64, 128      # bits Bullet itself does not use
+ALL = -1
+SUFFIX = "__ground_contact"
+CONTACT_MASS = 1e-3            # [kg] negligible next to the wheel's
+
+
+def add_contact_links(urdf_text, wheel_links):
+    """URDF text with a ground-contact sphere link fixed to each named wheel link whose
+    collision is a cylinder; returns (text, {wheel link: contact link})."""
+    root = ET.fromstring(urdf_text)
+    added = {}
+    for link in root.findall("link"):
+        name = link.get("name")
+        if name not in wheel_links:
+            continue
+        cylinder = link.find("collision/geometry/cylinder")
+        if cylinder is None:
+            continue
+        origin = link.find("collision/origin")
+        xyz = origin.get("xyz", "0 0 0") if origin is not None else "0 0 0"
+        contact = name + SUFFIX
+        contact_link = ET.SubElement(root, "link", name=contact)
+        inertial = ET.SubElement(contact_link, "inertial")
+        ET.SubElement(inertial, "mass", value=repr(CONTACT_MASS))
+        ET.SubElement(inertial, "inertia", ixx="1e-6", iyy="1e-6", izz="1e-6",
+                      ixy="0", ixz="0", iyz="0")
+        collision = ET.SubElement(contact_link, "collision")
+        ET.SubElement(collision, "origin", xyz=xyz, rpy="0 0 0")
+        geometry = ET.SubElement(collision, "geometry")
+        ET.SubElement(geometry, "sphere", radius=cylinder.get("radius"))
+        joint = ET.SubElement(root, "joint", name=contact + "_joint", type="fixed")
+        ET.SubElement(joint, "parent", link=name)
+        ET.SubElement(joint, "child", link=contact)
+        added[name] = contact
+    return ET.tostring(root, encoding="unicode"), added
+
+
+def apply_groups(client, body, links, contacts):
+    """Sets the collision groups of a loaded robot: `links` maps link names to indices,
+    `contacts` is add_contact_links' {wheel link: contact link}."""
+    for wheel, contact in contacts.items():
+        client.setCollisionFilterGroupMask(body, links[wheel], DEFAULT, ALL & ~(GROUND | CONTACT))
+        client.setCollisionFilterGroupMask(body, links[contact], CONTACT, GROUND)
+
+
+def mark_ground(client, body):
+    client.setCollisionFilterGroupMask(body, -1, GROUND, ALL)
