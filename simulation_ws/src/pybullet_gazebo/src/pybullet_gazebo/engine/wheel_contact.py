@@ -22,6 +22,9 @@ GROUND, CONTACT = 64, 128      # bits Bullet itself does not use
 ALL = -1
 SUFFIX = "__ground_contact"
 CONTACT_MASS = 1e-3            # [kg] negligible next to the wheel's
+# A real tyre's contact patch resists twisting about the vertical; a point contact does not,
+# and a robot at rest would creep round (0.03 deg/s). A small torsional friction stops it.
+SPINNING_FRICTION = 0.001      # [m] Bullet's spinning-friction lever
 
 
 def add_contact_links(urdf_text, wheel_links):
@@ -56,11 +59,15 @@ def add_contact_links(urdf_text, wheel_links):
 
 
 def apply_groups(client, body, links, contacts):
-    """Sets the collision groups of a loaded robot: `links` maps link names to indices,
-    `contacts` is add_contact_links' {wheel link: contact link}."""
+    """Sets the collision groups of a loaded robot, and gives each contact sphere its wheel's
+    friction: `links` maps link names to indices, `contacts` is add_contact_links' result.
+    Call it after the wheels' friction is set."""
     for wheel, contact in contacts.items():
         client.setCollisionFilterGroupMask(body, links[wheel], DEFAULT, ALL & ~(GROUND | CONTACT))
         client.setCollisionFilterGroupMask(body, links[contact], CONTACT, GROUND)
+        wheel_friction = client.getDynamicsInfo(body, links[wheel])[1]   # the wheel's mu
+        client.changeDynamics(body, links[contact], lateralFriction=wheel_friction,
+                              spinningFriction=SPINNING_FRICTION)
 
 
 def mark_ground(client, body):

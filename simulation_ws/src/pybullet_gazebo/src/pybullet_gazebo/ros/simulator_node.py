@@ -8,7 +8,8 @@ Node name `gazebo`, so its services are Gazebo's:
 Topics out:
   /clock (rosgraph_msgs/Clock) when /use_sim_time, at ~pub_clock_frequency [Hz sim]
   ~model_states (gazebo_msgs/ModelStates) at ~model_states_rate [Hz sim]
-  ~contacts (gazebo_msgs/ContactsState) each step a robot touches a model other than the ground
+  ~contacts (gazebo_msgs/ContactsState) the (robot, model) pairs touching, the ground excluded,
+            each time that set changes (an empty list when the last touch ends)
   per robot, from its <gazebo> tags: the laser's topicName (sensor_msgs/LaserScan) at the
   sensor's update_rate, the diff drive's odometryTopic (nav_msgs/Odometry) and TF
   odometryFrame -> robotBaseFrame at its updateRate.
@@ -56,6 +57,7 @@ class SimulatorNode:
         self.commands_received = 0
         self.command_arrived = threading.Condition()
         self._robot_io = {}                       # robot name -> (publishers, subscribers)
+        self._last_touching = []
         self._reset_pacing()
         # publication periods in whole physics steps, so they never drift
         self._clock_every = self._steps_per_period(params.pub_clock_frequency)
@@ -64,7 +66,7 @@ class SimulatorNode:
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) \
             if params.use_sim_time else None
         self.model_states_pub = rospy.Publisher("~model_states", ModelStates, queue_size=1)
-        self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=10)
+        self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100, latch=True)
         self.tf_broadcaster = tf2_ros.TransformBroadcaster()
         self.services = GazeboServices(self)
         rospy.loginfo("world '%s' loaded from %s: %d models, physics step %.4f s, "
@@ -157,7 +159,8 @@ class SimulatorNode:
 
     def _publish_world(self, stamp):
         touching = self.world.touching()
-        if touching:
+        if touching != self._last_touching:
+            self._last_touching = touching
             msg = ContactsState()
             msg.header.stamp = stamp
             msg.header.frame_id = "world"
@@ -208,9 +211,6 @@ class SimulatorNode:
 
     def after_reset(self):
         self._reset_pacing()
-        # publication periods in whole physics steps, so they never drift
-        self._clock_every = self._steps_per_period(params.pub_clock_frequency)
-        self._model_states_every = self._steps_per_period(params.model_states_rate)
 
     def shutdown(self):
         try:

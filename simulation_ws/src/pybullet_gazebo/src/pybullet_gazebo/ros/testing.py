@@ -1,6 +1,8 @@
 """Helpers for the rostest suites: waiting for messages and services with explicit time-outs,
-reading sim time and model poses. Used by test nodes only."""
+reading sim time and model poses, collecting a node's /rosout lines (NodeLog) and the
+simulator's touches from /gazebo/contacts (ContactLog). Used by test nodes only."""
 import math
+import threading
 import time
 
 import rospy
@@ -50,3 +52,63 @@ def wait_until_sim_time(target, timeout=60.0):
 
 def unwrap_angle(angle):
     return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def yaw_of(orientation):
+    """Yaw [rad] of a geometry_msgs/Quaternion."""
+    q = orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+class NodeLog:
+    """Collects what one node logs, from /rosout: `entries` is a list of (sim time [s], text).
+
+    `node` is the full node name, e.g. "/reading_laser". Subscribes at construction, so build
+    it before the node starts talking."""
+
+    def __init__(self, node):
+        from rosgraph_msgs.msg import Log
+        self.node = node
+        self.entries = []
+        self._lock = threading.Lock()
+        self._sub = rospy.Subscriber("/rosout", Log, self._on_log, queue_size=1000)
+
+    def _on_log(self, msg):
+        if msg.name == self.node:
+            with self._lock:
+                self.entries.append((msg.header.stamp.to_sec(), msg.msg))
+
+    def since(self, start):
+        """The entries stamped at or after sim time `start` [s]."""
+        with self._lock:
+            return [(t, text) for t, text in self.entries if t >= start]
+
+    def wait_for(self, count, since=0.0, timeout=30.0):
+        """Blocks until `count` entries stamped at or after `since` arrived; returns them.
+        AssertionError naming the node after `timeout` wall s."""
+        deadline = time.monotonic() + timeout
+        while len(self.since(since)) < count:
+            if time.monotonic() > deadline:
+                raise AssertionError("node %s logged %d messages on /rosout after sim time "
+                                     "%.2f s within %.0f s, wanted %d; is it running?"
+                                     % (self.node, len(self.since(since)), since, timeout, count))
+            time.sleep(0.02)
+        return self.since(since)
+
+
+class ContactLog:
+    """Every touch the simulator reports on its latched /gazebo/contacts topic: `touches` is a
+    list of (sim time [s], ["robot touches model", ...]), one per non-empty message."""
+
+    def __init__(self, topic="/gazebo/contacts"):
+        from gazebo_msgs.msg import ContactsState
+        self.touches = []
+        self.messages = 0
+        self._sub = rospy.Subscriber(topic, ContactsState, self._on_contacts, queue_size=1000)
+
+    def _on_contacts(self, msg):
+        self.messages += 1
+        if msg.states:
+            self.touches.append((msg.header.stamp.to_sec(),
+                                 ["%s touches %s" % (s.collision1_name, s.collision2_name)
+                                  for s in msg.states]))

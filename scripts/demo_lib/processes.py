@@ -1,0 +1,196 @@
+"""Child processes of the demo and the benchmark: a free port, starting commands in process
+groups of their own with their output in log files, stopping them (SIGINT to the group, then
+SIGTERM, then SIGKILL after time-outs), and finding any process left behind.
+
+A process belongs to a run when its environment carries that run's ROS_MASTER_URI (every
+child inherits it, and roslaunch passes it on to the nodes it starts in sessions of their
+own), so `leftovers(master_uri)` finds orphans whoever their parent was.
+"""
+import os
+import signal
+import socket
+import subprocess
+import time
+
+
+def free_port(host="127.0.0.1"):
+    """A TCP port nobody listens on now (the kernel's pick). Another program may take it
+    before we bind it; callers retry on a clash."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind((host, 0))
+        return sock.getsockname()[1]
+
+
+def port_in_use(port, host="127.0.0.1"):
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.settimeout(0.5)
+        return sock.connect_ex((host, port)) == 0
+
+
+class Child:
+    """A command started in a new session (its own process group), output to a log file."""
+
+    def __init__(self, name, argv, env, log_path):
+        self.name = name
+        self.argv = list(argv)
+        self.log_path = log_path
+        os.makedirs(os.path.dirname(os.path.abspath(log_path)), exist_ok=True)
+        self._log = open(log_path, "wb")
+        try:
+            self.popen = subprocess.Popen(self.argv, env=env, stdout=self._log,
+                                          stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                          start_new_session=True)
+        except OSError as err:
+            self._log.close()
+            raise RuntimeError("cannot start %s (%s): %s" % (name, " ".join(self.argv), err))
+        self.pid = self.popen.pid
+        self.started = time.monotonic()
+
+    def running(self):
+        return self.popen.poll() is None
+
+    @property
+    def returncode(self):
+        return self.popen.poll()
+
+    def wait(self, timeout):
+        """Exit code, or None if still running after `timeout` [s]."""
+        try:
+            return self.popen.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return None
+
+    def log_tail(self, lines=20):
+        self._log.flush()
+        try:
+            with open(self.log_path, "rb") as log:
+                text = log.read().decode("utf-8", "replace")
+        except OSError:
+            return ""
+        return "\n".join(text.rstrip().splitlines()[-lines:])
+
+    def signal_group(self, signum):
+        try:
+            os.killpg(self.pid, signum)
+        except ProcessLookupError:
+            pass
+
+    def close(self):
+        self._log.close()
+
+
+def stop(children, sigint_timeout=20.0, sigterm_timeout=5.0):
+    """Stops `children` together: SIGINT to each one's process group, SIGTERM to those still
+    running after `sigint_timeout` [s], SIGKILL after `sigterm_timeout` more. Returns
+    {name: how it ended} ("exit N", "SIGTERM", "SIGKILL")."""
+    outcome = {}
+    steps = ((signal.SIGINT, sigint_timeout), (signal.SIGTERM, sigterm_timeout),
+             (signal.SIGKILL, 5.0))
+    pending = [c for c in children if c.running()]
+    for child in children:
+        if not child.running():
+            outcome[child.name] = "exit %s" % child.returncode
+    for signum, timeout in steps:
+        for child in pending:
+            child.signal_group(signum)
+        deadline = time.monotonic() + timeout
+        for child in pending:
+            code = child.wait(max(0.0, deadline - time.monotonic()))
+            if code is not None:
+                outcome[child.name] = ("exit %s" % code if signum == signal.SIGINT
+                                       else signal.Signals(signum).name)
+        pending = [c for c in pending if c.running()]
+        if not pending:
+            break
+    for child in children:
+        child.close()
+    return outcome
+
+
+def environment_of(pid):
+    """{name: value} of a process's start-up environment ({} when unreadable or gone)."""
+    try:
+        with open("/proc/%d/environ" % pid, "rb") as source:
+            raw = source.read()
+    except OSError:
+        return {}
+    env = {}
+    for item in raw.split(b"\0"):
+        name, sep, value = item.partition(b"=")
+        if sep:
+            env[name.decode("utf-8", "replace")] = value.decode("utf-8", "replace")
+    return env
+
+
+def leftovers(master_uri, exclude=()):
+    """PIDs of live processes (zombies excluded) started with ROS_MASTER_URI == master_uri,
+    other than this process and `exclude`."""
+    skip = {os.getpid(), *exclude}
+    found = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit() or int(entry) in skip:
+            continue
+        pid = int(entry)
+        if environment_of(pid).get("ROS_MASTER_URI") == master_uri and not _zombie(pid):
+            found.append(pid)
+    return sorted(found)
+
+
+def _zombie(pid):
+    try:
+        with open("/proc/%d/stat" % pid) as source:
+            return source.read().rsplit(")", 1)[1].split()[0] in ("Z", "X")
+    except (OSError, IndexError):
+        return True
+
+
+def describe(pids):
+    """`ps` lines (pid, state, command) of `pids`, for an error message."""
+    if not pids:
+        return ""
+    result = subprocess.run(["ps", "-o", "pid=,stat=,args=", "-p", ",".join(map(str, pids))],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    return result.stdout.rstrip()
+
+
+def kill_leftovers(master_uri, exclude=(), timeout=5.0):
+    """SIGTERM, then SIGKILL, to every process of the run still alive; returns the `ps`
+    description of what was found (empty when nothing was)."""
+    pids = leftovers(master_uri, exclude)
+    if not pids:
+        return ""
+    text = describe(pids)
+    for signum in (signal.SIGTERM, signal.SIGKILL):
+        for pid in pids:
+            try:
+                os.kill(pid, signum)
+            except ProcessLookupError:
+                pass
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and leftovers(master_uri, exclude):
+            time.sleep(0.1)
+        pids = leftovers(master_uri, exclude)
+        if not pids:
+            break
+    return text
+
+
+def peak_rss_kib(pid):
+    """VmHWM (peak resident set) of a process [KiB], or None when it is gone."""
+    return _status_field(pid, "VmHWM")
+
+
+def rss_kib(pid):
+    """VmRSS (resident set now) of a process [KiB], or None when it is gone."""
+    return _status_field(pid, "VmRSS")
+
+
+def _status_field(pid, field):
+    try:
+        with open("/proc/%d/status" % pid) as source:
+            for line in source:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1])
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
