@@ -23,9 +23,12 @@ Wheel speeds for a command (v [m/s], w [rad/s]): the joint NAMED by leftJoint tu
 (v - w * separation / 2) / radius and the joint named by rightJoint at
 (v + w * separation / 2) / radius [rad/s], whatever side of the robot they are on (for m2wr,
 whose "right" joint sits on its left, a positive w turns the robot clockwise, as in Gazebo).
-A speed above the joint's URDF velocity limit is clamped to it. The last command is held for
-ever, as in Gazebo, unless command_timeout [s of sim time] > 0. Unlike Gazebo, a command with
-a non-finite value is refused (set_command returns False) and the previous one kept.
+A speed above the joint's URDF velocity limit is clamped to it (reported once per joint);
+Bullet, besides, never turns a joint faster than its maxJointVelocity (100 rad/s by default,
+10 m/s at m2wr's rim). Under such a command m2wr may rear up and turn over: physics, as in
+Gazebo. The last command is held for ever, as in Gazebo, unless command_timeout [s of sim
+time] > 0. Unlike Gazebo, a command with a non-finite value is refused (set_command returns
+False) and the previous one kept.
 
 Odometry (odometrySource world): the true pose of the base link frame in the world and its
 velocity, linear (of the link frame's origin) and angular, both expressed in the base link

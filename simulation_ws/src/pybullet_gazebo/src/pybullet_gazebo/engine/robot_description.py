@@ -61,11 +61,14 @@ _SENSOR_TAGS_IGNORED = {"visualize", "always_on", "topic"}
 
 def parse_robot(urdf_xml: str, model_name: str) -> RobotSpec:
     """The RobotSpec of a URDF text. Raises RobotDescriptionError when the text is empty,
-    not XML, not a <robot>, has no single root link, or holds a value that is not a number
-    where a number must be."""
+    not XML, not a <robot>, still xacro, has no single root link, has a joint of no URDF
+    type, or holds a value that is not a (finite, >= 0 where required) number where a
+    number must be."""
     root = _parse_xml(urdf_xml)
+    _check_expanded(root)
     links, joints = _links_and_joints(root)
     root_link = _root_link(links, joints)
+    _check_urdf_values(root)
     warnings: List[str] = []
     plugins: List[PluginSpec] = []
     sensors: List[RaySensorSpec] = []
@@ -199,6 +202,77 @@ def _links_and_joints(root):
             ends.append(link)
         joints[name] = (ends[0], ends[1])
     return links, joints
+
+
+# URDF attributes that must hold numbers: (element path under a link or joint, attribute,
+# count, lowest value or None). Bullet's loader reads text such as "a b c" or "nan" without a
+# word and builds a body with no collision or a NaN mass; urdfdom (Gazebo) refuses them.
+_LINK_NUMBERS = (
+    ("inertial/origin", "xyz", 3, None), ("inertial/origin", "rpy", 3, None),
+    ("inertial/mass", "value", 1, 0.0),
+    *(("inertial/inertia", key, 1, None) for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")),
+    *((part + "/origin", key, 3, None) for part in ("visual", "collision")
+      for key in ("xyz", "rpy")),
+    *((part + "/geometry/box", "size", 3, 0.0) for part in ("visual", "collision")),
+    *((part + "/geometry/cylinder", key, 1, 0.0) for part in ("visual", "collision")
+      for key in ("radius", "length")),
+    *((part + "/geometry/sphere", "radius", 1, 0.0) for part in ("visual", "collision")),
+    *((part + "/geometry/mesh", "scale", 3, None) for part in ("visual", "collision")),
+)
+_JOINT_NUMBERS = (
+    ("origin", "xyz", 3, None), ("origin", "rpy", 3, None), ("axis", "xyz", 3, None),
+    ("limit", "lower", 1, None), ("limit", "upper", 1, None),
+    ("limit", "effort", 1, 0.0), ("limit", "velocity", 1, 0.0),
+    ("dynamics", "damping", 1, None), ("dynamics", "friction", 1, None),
+)
+_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+
+
+def _check_expanded(root):
+    """A description passed before xacro ran on it still holds <xacro:...> elements (its
+    macros, includes and ${...} values would be silently missing)."""
+    for element in root.iter():
+        namespace, _, tag = str(element.tag).rpartition("}")
+        if "xacro" in namespace:
+            raise RobotDescriptionError(
+                "the description holds <xacro:%s>: it is a xacro file, not yet a URDF; expand "
+                "it first (xacro FILE > robot.urdf), as spawn.launch does" % tag)
+
+
+def _check_urdf_values(root):
+    """Every number the URDF hands to Bullet is a finite number (>= 0 where the URDF
+    demands it), every joint has a URDF type and a non-zero axis; else RobotDescriptionError
+    naming the link or joint, the element and the text."""
+    def check(owner, element, path, attribute, count, lowest):
+        for found in element.findall(path):
+            text = found.get(attribute)
+            if text is None:
+                continue
+            try:
+                values = [float(v) for v in text.split()]
+            except ValueError:
+                values = []
+            if len(values) != count or not all(math.isfinite(v) for v in values) or (
+                    lowest is not None and min(values) < lowest):
+                raise RobotDescriptionError(
+                    "%s <%s %s=\"%s\">: expected %d finite number%s%s; fix the URDF"
+                    % (owner, path, attribute, text, count, "s" if count > 1 else "",
+                       "" if lowest is None else " >= %g" % lowest))
+    for link in root.findall("link"):
+        for rule in _LINK_NUMBERS:
+            check("link '%s'" % link.get("name"), link, *rule)
+    for joint in root.findall("joint"):
+        owner = "joint '%s'" % joint.get("name", "")
+        if joint.get("type") not in _JOINT_TYPES:
+            raise RobotDescriptionError("%s has type '%s'; a URDF joint is one of %s"
+                                        % (owner, joint.get("type"), ", ".join(_JOINT_TYPES)))
+        for rule in _JOINT_NUMBERS:
+            check(owner, joint, *rule)
+        axis = joint.find("axis")
+        if axis is not None and axis.get("xyz") is not None and \
+                not any(float(v) for v in axis.get("xyz").split()):
+            raise RobotDescriptionError("%s <axis xyz=\"%s\"> is a zero vector; give the "
+                                        "joint's axis" % (owner, axis.get("xyz")))
 
 
 def _root_link(links, joints):

@@ -194,6 +194,13 @@ class _WorldReader:
                              % (owner, what, text, count))
         return values
 
+    def sizes(self, values, owner, what, where):
+        """values, when none is negative (a shape's extents [m])."""
+        if min(values) < 0.0:
+            raise self.error("%s: %s %s in %s must not be negative [m]; fix the value"
+                             % (owner, what, " ".join("%g" % v for v in values), where))
+        return values
+
     def number(self, elem, tag, default, owner):
         text = _text(elem, tag)
         if text is None:
@@ -391,15 +398,23 @@ class _WorldReader:
         shape = shapes[0]
         tag = shape.tag
         if tag == "box":
-            return Box(tuple(self.numbers(_text(shape, "size", "1 1 1"), 3, owner, "size")))
+            return Box(tuple(self.sizes(self.numbers(_text(shape, "size", "1 1 1"), 3, owner,
+                                                     "size"), owner, "box <size>", where)))
         if tag == "cylinder":
-            return Cylinder(radius=self.number(shape, "radius", 1.0, owner),
-                            length=self.number(shape, "length", 1.0, owner))
+            radius, length = self.sizes([self.number(shape, "radius", 1.0, owner),
+                                         self.number(shape, "length", 1.0, owner)],
+                                        owner, "cylinder <radius> <length>", where)
+            return Cylinder(radius=radius, length=length)
         if tag == "sphere":
-            return Sphere(radius=self.number(shape, "radius", 1.0, owner))
+            return Sphere(radius=self.sizes([self.number(shape, "radius", 1.0, owner)], owner,
+                                            "sphere <radius>", where)[0])
         if tag == "plane":
+            normal = tuple(self.numbers(_text(shape, "normal", "0 0 1"), 3, owner, "normal"))
+            if not any(normal):
+                raise self.error("%s: plane <normal> 0 0 0 in %s is not a direction; write "
+                                 "0 0 1 for flat ground" % (owner, where))
             return Plane(
-                normal=tuple(self.numbers(_text(shape, "normal", "0 0 1"), 3, owner, "normal")),
+                normal=normal,
                 size=tuple(self.numbers(_text(shape, "size", "1 1"), 2, owner, "size")))
         if tag == "mesh":
             uri = _text(shape, "uri", "")

@@ -25,6 +25,13 @@ from .specs import Box, Cylinder, Mesh, Plane, Sphere, WorldSpec
 from .transforms import Pose
 
 
+# Bounds on what a request may ask: Bullet's state overflows to NaN for extreme values (a
+# twist of 1e160 turns every touching body's pose into NaN), and far from the origin contacts
+# and rays lose their precision. Nothing the tutorial does comes near them.
+MAX_COORDINATE = 1.0e6          # [m] per axis, for a spawn or set_model_state position
+MAX_VELOCITY = 1.0e6            # [m/s] and [rad/s] per axis, for a set_model_state twist
+
+
 class SpawnError(ValueError):
     """A model could not be spawned; the message says why and what to do. The world is
     left as it was."""
@@ -165,6 +172,13 @@ class World:
         values = list(pose.position) + list(pose.orientation) + list(linear) + list(angular)
         if not all(math.isfinite(v) for v in values):
             raise ValueError("model state for '%s' has a non-finite value; nothing changed" % name)
+        if max(abs(v) for v in pose.position) > MAX_COORDINATE:
+            raise ValueError("position of '%s' %s is over %g m from the origin; nothing changed"
+                             % (name, tuple(pose.position), MAX_COORDINATE))
+        if max(abs(v) for v in list(linear) + list(angular)) > MAX_VELOCITY:
+            raise ValueError("twist of '%s' (linear %s, angular %s) is over %g m/s or rad/s; "
+                             "nothing changed"
+                             % (name, tuple(linear), tuple(angular), MAX_VELOCITY))
         norm = math.sqrt(sum(q * q for q in pose.orientation))
         if norm < 1e-9:
             raise ValueError("orientation of '%s' is a zero quaternion; nothing changed" % name)
@@ -219,6 +233,14 @@ class World:
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
             raise SpawnError("spawn pose of '%s' is not finite: %s; pass numbers for -x -y -z"
                              % (name, values))
+        if max(abs(v) for v in pose.position) > MAX_COORDINATE:
+            raise SpawnError("spawn position of '%s' %s is over %g m from the origin; pass -x -y "
+                             "-z within the world" % (name, tuple(pose.position), MAX_COORDINATE))
+        norm = math.sqrt(sum(q * q for q in pose.orientation))
+        if norm < 1e-9:          # Bullet would keep it and the robot's sensors would see NaN
+            raise SpawnError("spawn orientation of '%s' is a zero quaternion %s; pass a unit "
+                             "quaternion (or -R -P -Y)" % (name, tuple(pose.orientation)))
+        pose = Pose(pose.position, tuple(q / norm for q in pose.orientation))
         try:
             spec = parse_robot(urdf_xml, name)
         except Exception as err:   # the parser names what is wrong with the description
@@ -233,6 +255,10 @@ class World:
             if inside:
                 raise SpawnError("spawn pose (%.3f, %.3f, %.3f) puts '%s' inside %s; choose a "
                                  "free pose" % (pose.position + (name, ", ".join(inside))))
+            below = self._grounds_above(body)
+            if below:
+                raise SpawnError("spawn pose (%.3f, %.3f, %.3f) puts all of '%s' under %s; "
+                                 "raise -z" % (pose.position + (name, ", ".join(below))))
         except Exception:
             self.client.removeBody(body)
             raise
@@ -253,7 +279,8 @@ class World:
                 if joint.get("name") in joint_names and joint.find("child") is not None}
 
     def _load_urdf(self, name, urdf_text, pose):
-        handle, path = tempfile.mkstemp(prefix="pybullet_gazebo_%s_" % name, suffix=".urdf")
+        # the model name stays out of the file name: it may hold '/' or anything else
+        handle, path = tempfile.mkstemp(prefix="pybullet_gazebo_", suffix=".urdf")
         try:
             with os.fdopen(handle, "w") as out:
                 out.write(urdf_text)
@@ -315,6 +342,32 @@ class World:
             for point in self.client.getClosestPoints(body, other_body, distance=0.0):
                 if point[8] < -0.001:      # contact distance [m]; negative = penetration
                     names.add(owner)
+        return sorted(names)
+
+    def _grounds_above(self, body) -> List[str]:
+        """Names of the ground models whose plane has the whole body (every corner of its
+        links' bounding boxes) on its underside. Bullet's plane is a half-space: a body
+        under it would be thrown out of the ground, not left to fall."""
+        corners = []
+        for link in range(-1, self.client.getNumJoints(body)):
+            low, high = self.client.getAABB(body, link)
+            corners += [(x, y, z) for x in (low[0], high[0]) for y in (low[1], high[1])
+                        for z in (low[2], high[2])]
+        corners = np.array(corners)
+        names = set()
+        for entity in self.entities.values():
+            if not entity.is_ground:
+                continue
+            for ground in entity.body_ids:
+                position, orientation = self.client.getBasePositionAndOrientation(ground)
+                frame = Pose(tuple(position), tuple(orientation))    # shapes sit in this frame
+                for shape in self.client.getCollisionShapeData(ground, -1):
+                    if shape[2] != pybullet.GEOM_PLANE:
+                        continue
+                    plane = frame.compose(Pose(tuple(shape[5]), tuple(shape[6])))
+                    normal = plane.matrix @ np.asarray(shape[3], dtype=float)
+                    if np.max((corners - np.asarray(plane.position)) @ normal) < 0.0:
+                        names.add(entity.name)
         return sorted(names)
 
     def positive_turn_direction(self, robot) -> Optional[str]:

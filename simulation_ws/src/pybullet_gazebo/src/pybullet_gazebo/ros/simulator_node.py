@@ -3,6 +3,7 @@
 Node name `gazebo`, so its services are Gazebo's:
   ~reset_simulation, ~reset_world, ~pause_physics, ~unpause_physics  (std_srvs/Empty)
   ~spawn_urdf_model (gazebo_msgs/SpawnModel), ~delete_model (gazebo_msgs/DeleteModel)
+  ~spawn_sdf_model (gazebo_msgs/SpawnModel): always answers false (URDF only)
   ~get_model_state / ~set_model_state (gazebo_msgs/GetModelState / SetModelState)
   ~get_world_properties / ~get_physics_properties
 Topics out:

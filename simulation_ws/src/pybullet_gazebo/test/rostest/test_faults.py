@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""rostest: faults mid-run in world02 with m2wr at (0, 8) and the tutorial's controller
+(motion_plan's obstacle_avoidance.py, started and killed by this test).
+
+1. The controller killed with SIGKILL: the simulation goes on (/clock, /odom); a controller
+   started again drives the robot (from (0, 8) it sees nothing ahead: 0.6 m/s forward).
+2. reset_simulation with the controller running: m2wr is back at its spawn pose (0, 8, 0.5),
+   sim time restarts at 0, and the same controller process goes on driving it.
+Over the whole run /clock goes backwards exactly once: at the reset.
+"""
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+import unittest
+
+import rospkg
+import rospy
+import rostest
+from geometry_msgs.msg import Twist
+from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reliability import ClockWatch, OdomWatch, state   # noqa: E402
+from pybullet_gazebo.ros.testing import service, wait_for_message, wait_until_sim_time  # noqa: E402
+
+CONTROLLER = ["rosrun", "motion_plan", "obstacle_avoidance.py"]
+START = (0.0, 8.0, 0.5)          # [m] spawn.launch y:=8 (z 0.5: dropped onto its wheels)
+
+
+class CommandWatch:
+    """Wall times of the /cmd_vel messages received, by publishing node."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self.received = []                 # (wall time [s], caller id)
+        self._sub = rospy.Subscriber("/cmd_vel", Twist, self._on_command, queue_size=100)
+
+    def _on_command(self, msg):
+        with self._lock:
+            self.received.append((time.monotonic(), msg._connection_header["callerid"]))
+
+    def count_after(self, wall_time):
+        with self._lock:
+            return sum(1 for t, _ in self.received if t > wall_time)
+
+    def wait_after(self, wall_time, timeout=30.0):
+        deadline = time.monotonic() + timeout
+        while self.count_after(wall_time) == 0:
+            if time.monotonic() > deadline:
+                raise AssertionError("no /cmd_vel within %.0f s: is the controller running?"
+                                     % timeout)
+            time.sleep(0.05)
+
+
+class FaultsTest(unittest.TestCase):
+    controller = None
+
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_faults")
+        try:
+            rospkg.RosPack().get_path("motion_plan")
+        except rospkg.ResourceNotFound:
+            raise AssertionError("package motion_plan (catkin_ws) not found: source "
+                                 "scripts/env.sh, whose catkin_ws overlays simulation_ws")
+        cls.clock = ClockWatch()
+        cls.odom = OdomWatch()
+        cls.commands = CommandWatch()
+        cls.reset_world = service("/gazebo/reset_world", Empty, timeout=30)
+        cls.reset_simulation = service("/gazebo/reset_simulation", Empty)
+        wait_for_message("/m2wr/laser/scan", LaserScan, timeout=30)
+        wait_until_sim_time(rospy.get_time() + 1.0)          # dropped from z 0.5, settled
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.kill_controller()
+
+    @classmethod
+    def start_controller(cls):
+        started = time.monotonic()
+        cls.controller = subprocess.Popen(CONTROLLER, stdout=subprocess.DEVNULL,
+                                          stderr=subprocess.DEVNULL, start_new_session=True)
+        return started
+
+    @classmethod
+    def kill_controller(cls):
+        if cls.controller is not None and cls.controller.poll() is None:
+            os.killpg(cls.controller.pid, signal.SIGKILL)
+            cls.controller.wait(timeout=10)
+
+    def assert_drives_forward(self, seconds=1.5, at_least=0.3):
+        """The robot's x grows by at_least [m] within `seconds` [s] of sim time."""
+        t0, x0 = state()[:2]
+        wait_until_sim_time(t0 + seconds)
+        self.assertGreater(state()[1] - x0, at_least)
+
+    def test_1_controller_killed_and_restarted(self):
+        started = self.start_controller()
+        self.commands.wait_after(started)
+        self.assert_drives_forward()
+
+        self.kill_controller()
+        killed = time.monotonic()
+        self.assertEqual(self.controller.returncode, -signal.SIGKILL)
+        t_kill = state()[0]
+        wait_until_sim_time(t_kill + 1.0, timeout=20)         # the simulation goes on
+        self.assertGreater(len(self.odom.since(t_kill)), 10)
+        self.assertEqual(self.commands.count_after(killed + 0.5), 0)   # nobody commands now
+
+        self.reset_world()                                    # stop it, back at the start
+        t0, x0 = state()[:2]
+        wait_until_sim_time(t0 + 1.0)
+        self.assertLess(abs(state()[1] - x0), 0.01)          # at rest without a controller
+
+        restarted = self.start_controller()
+        self.commands.wait_after(restarted)
+        self.assert_drives_forward()                          # the new controller drives
+
+    def test_2_reset_simulation_mid_run_with_the_controller_running(self):
+        if self.controller is None or self.controller.poll() is not None:
+            self.start_controller()
+            self.commands.wait_after(time.monotonic() - 0.1)
+        wait_until_sim_time(rospy.get_time() + 1.0)
+        before = state()
+        self.assertGreater(before[0], 2.0)
+        self.assertGreater(before[1], 0.3)                    # it has driven away
+
+        self.reset_simulation()
+        t, x, y, z, yaw = state()
+        self.assertLess(t, 0.3)                               # sim time restarted at 0
+        self.assertAlmostEqual(x, START[0], delta=0.02)
+        self.assertAlmostEqual(y, START[1], delta=0.02)
+        self.assertGreater(z, 0.2)                            # still dropping from 0.5
+        self.assertAlmostEqual(yaw, 0.0, delta=0.02)
+
+        reset_at = time.monotonic()
+        self.commands.wait_after(reset_at)                    # the controller goes on
+        wait_until_sim_time(1.0)                              # landed
+        self.assert_drives_forward()
+        self.assertIsNone(self.controller.poll())             # and is still alive
+
+        jumps = self.clock.backward_jumps()
+        self.assertEqual(len(jumps), 1, jumps)                # only the reset went back
+        self.assertLess(jumps[0][1], 0.1)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("pybullet_gazebo", "faults", FaultsTest)
