@@ -194,3 +194,13 @@ def _status_field(pid, field):
     except (OSError, ValueError, IndexError):
         return None
     return None
+
+
+def cpu_seconds(pid):
+    """User + system CPU time a process has used [s], or None when it is gone."""
+    try:
+        with open("/proc/%d/stat" % pid) as source:
+            fields = source.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None

@@ -28,6 +28,11 @@ from pybullet_gazebo.ros.testing import (ContactLog, NodeLog, unwrap_angle, wait
 CASE_LINE = re.compile(r"case (\d) - ")
 
 
+def path_length(poses):
+    """[m] the polyline through the (t, x, y, yaw) poses."""
+    return sum(math.hypot(b[1] - a[1], b[2] - a[2]) for a, b in zip(poses, poses[1:]))
+
+
 class ObstacleAvoidanceTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -53,10 +58,10 @@ class ObstacleAvoidanceTest(unittest.TestCase):
     def summary(cls):
         with cls.lock:
             poses = [pose for pose in cls.poses if cls.start <= pose[0] <= cls.end]
-        path = sum(math.hypot(b[1] - a[1], b[2] - a[2]) for a, b in zip(poses, poses[1:]))
+        path = path_length(poses)
         counts = {}
-        for _, text in cls.program_log.since(cls.start):
-            m = CASE_LINE.match(text)
+        for t, text in cls.program_log.since(cls.start):
+            m = CASE_LINE.match(text) if t <= cls.end else None
             if m:
                 counts[int(m.group(1))] = counts.get(int(m.group(1)), 0) + 1
         return ("path %.2f m, from (%.2f, %.2f) to (%.2f, %.2f); case lines %s; touches %s"
@@ -80,14 +85,14 @@ class ObstacleAvoidanceTest(unittest.TestCase):
             return [pose for pose in self.poses if self.start <= pose[0] <= self.end]
 
     def test_starts_where_spawned(self):
-        t, x, y, yaw = self.watched_poses()[0]
+        _, x, y, yaw = self.watched_poses()[0]
         self.assertAlmostEqual(x, self.start_pose[0], delta=0.1)
         self.assertAlmostEqual(y, self.start_pose[1], delta=0.1)
         self.assertAlmostEqual(unwrap_angle(yaw - self.start_pose[2]), 0.0, delta=0.05)
 
     def test_travels_far_enough(self):
         poses = self.watched_poses()
-        path = sum(math.hypot(b[1] - a[1], b[2] - a[2]) for a, b in zip(poses, poses[1:]))
+        path = path_length(poses)
         self.assertGreaterEqual(
             path, self.min_distance,
             "m2wr drove %.2f m in %.0f s of sim time (from (%.2f, %.2f) to (%.2f, %.2f)); "
@@ -95,7 +100,7 @@ class ObstacleAvoidanceTest(unittest.TestCase):
                                         poses[-1][1], poses[-1][2], self.min_distance))
 
     def test_passes_through_several_cases(self):
-        lines = self.program_log.since(self.start)
+        lines = [(t, text) for t, text in self.program_log.since(self.start) if t <= self.end]
         cases = sorted({int(m.group(1)) for m in (CASE_LINE.match(text) for _, text in lines) if m})
         self.assertGreater(len(lines), 0, "obstacle_avoidance.py (node /reading_laser) logged nothing")
         self.assertGreaterEqual(

@@ -1,0 +1,317 @@
+#!/usr/bin/env python3
+"""The tutorial's episode 5, end to end: m2wr in world02 driven by obstacle_avoidance.py.
+
+  scripts/demo.sh [--world world02] [--x 0 --y 8 --yaw 0] [--duration 120] [--seed 0]
+                  [--gui] [--realtime] [--bag] [--output output/]
+
+Steps: its own ROS master on a free localhost port -> `roslaunch my_worlds
+launch_world.launch` (paused; headless, real_time_factor 0 and lockstep unless --realtime or
+--gui, which run at real time) -> `roslaunch m2wr_description spawn.launch x:= y:= yaw:=` ->
+`rosrun motion_plan obstacle_avoidance.py` (the tutorial's program, unchanged) -> physics
+unpaused for --duration seconds of sim time, with a progress line every ~2 s of wall time ->
+physics paused, everything stopped (SIGINT, then SIGTERM/SIGKILL; no process left behind) ->
+a top-down picture <output>/demo_<world>.png, a summary printed and written to
+<output>/demo_<world>.json, and with --bag <output>/demo_<world>.bag (/m2wr/laser/scan,
+/odom, /cmd_vel). Child logs and ROS logs go to <output>/logs/demo/.
+
+Exit status: 0 on success; 1 when a step fails (the message names the step and shows the
+failing program's own error); 2 for bad arguments; 130 when interrupted.
+"""
+import argparse
+import json
+import math
+import os
+import signal
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+
+from demo_lib import processes, summary                 # noqa: E402
+from demo_lib.session import Session, SessionError      # noqa: E402
+
+BAG_TOPICS = ("/m2wr/laser/scan", "/odom", "/cmd_vel")
+SCAN_HEIGHT = 0.15          # [m] the laser's plane above the ground, where obstacles are cut
+PROGRESS_PERIOD = 2.0       # [s] wall
+DEFAULT_CLOCK_HZ = 20.0     # [Hz] sim; the simulator also publishes /clock with every scan
+
+
+class Interrupted(Exception):
+    pass
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(
+        prog="demo.sh", description="Episode 5 of 'Exploring ROS with a 2 Wheeled Robot': "
+        "obstacle_avoidance.py drives m2wr in the pybullet stand-in; writes a picture and a "
+        "summary.")
+    parser.add_argument("--world", default="world02",
+                        help="world01, world02 or a path to a .world file (default world02)")
+    parser.add_argument("--x", type=float, default=0.0, help="start x [m] (default 0)")
+    parser.add_argument("--y", type=float, default=8.0, help="start y [m] (default 8, the "
+                        "tutorial's `spawn.launch y:=8`)")
+    parser.add_argument("--yaw", type=float, default=0.0, help="start heading [rad] (default 0)")
+    parser.add_argument("--duration", type=float, default=120.0,
+                        help="sim time to run the controller [s] (default 120)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the laser noise (default 0)")
+    parser.add_argument("--gui", action="store_true",
+                        help="open pybullet's window (needs a display); runs at real time")
+    parser.add_argument("--realtime", action="store_true",
+                        help="run at real time (real_time_factor 1, no lockstep) instead of "
+                        "as fast as possible in lockstep")
+    parser.add_argument("--bag", action="store_true",
+                        help="record /m2wr/laser/scan, /odom, /cmd_vel to <output>/demo_<world>.bag")
+    parser.add_argument("--output", default=os.path.join(ROOT, "output"),
+                        help="folder for the picture, summary, bag and logs (default output/)")
+    parser.add_argument("--clock-hz", type=float, default=DEFAULT_CLOCK_HZ,
+                        help="/clock rate [Hz of sim time] passed to the simulator as "
+                        "pub_clock_frequency (default %g; the simulator's own default is 100)"
+                        % DEFAULT_CLOCK_HZ)
+    args = parser.parse_args(argv)
+    for name in ("x", "y", "yaw", "duration", "clock_hz"):
+        if not math.isfinite(getattr(args, name)):
+            parser.error("--%s must be a finite number" % name.replace("_", "-"))
+    if args.duration <= 0:
+        parser.error("--duration must be > 0 seconds of sim time")
+    if args.clock_hz <= 0:
+        parser.error("--clock-hz must be > 0")
+    return args
+
+
+def world_label(world):
+    base = os.path.basename(world.rstrip("/"))
+    return base[:-len(".world")] if base.endswith(".world") else base
+
+
+_T0 = time.monotonic()
+
+
+def say(text):
+    print("[demo %5.1fs] %s" % (time.monotonic() - _T0, text), flush=True)
+
+
+def call_empty(name, timeout=10.0):
+    import rospy
+    from std_srvs.srv import Empty
+    rospy.wait_for_service(name, timeout=timeout)
+    rospy.ServiceProxy(name, Empty)()
+
+
+def model_poses():
+    """{name: Pose} of every model, from /gazebo/get_world_properties and get_model_state."""
+    import rospy
+    from gazebo_msgs.srv import GetModelState, GetWorldProperties
+    from pybullet_gazebo.engine.transforms import Pose
+    names = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)().model_names
+    get = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+    poses = {}
+    for name in names:
+        state = get(name, "")
+        if state.success:
+            p, q = state.pose.position, state.pose.orientation
+            poses[name] = Pose((p.x, p.y, p.z), (q.x, q.y, q.z, q.w))
+    return poses
+
+
+def run(args, session, paths):
+    """The ROS part; returns what the offline part needs."""
+    import rospy
+    from demo_lib.recorder import Recorder
+
+    realtime = args.realtime or args.gui
+    say("starting a ROS master on a free port")
+    uri = session.start_master()
+    os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
+    os.environ.pop("ROS_IP", None)
+    say("master %s (logs in %s)" % (uri, session.log_dir))
+    rospy.init_node("m2wr_demo", disable_signals=True)
+    recorder = Recorder()
+
+    say("simulator: %s, %s" % (args.world, "real time" if realtime
+                                else "as fast as possible, lockstep"))
+    session.launch_world(args.world, gui=args.gui, real_time_factor=1.0 if realtime else 0.0,
+                         lockstep=not realtime, seed=args.seed, paused=True,
+                         pub_clock_frequency=args.clock_hz)
+    # the three start together (physics is paused): spawn_model waits for the simulator's
+    # service, and the controller for scans; each is checked in turn below
+    say("spawning m2wr at x %g y %g yaw %g; starting obstacle_avoidance.py"
+        % (args.x, args.y, args.yaw))
+    session.start_spawn(args.x, args.y, args.yaw)
+    session.start_controller()
+    session.wait_for_simulator()
+    session.finish_spawn()
+    urdf = rospy.get_param("/robot_description")
+    if args.bag:
+        session.start_bag(paths["bag"], BAG_TOPICS)
+        _wait_for_bag(session)
+    session.wait_for_controller()
+    say("m2wr spawned, obstacle_avoidance.py connected; running")
+
+    start = recorder.sim_time or 0.0
+    recorder.fire_at(start + args.duration)
+    call_empty("/gazebo/unpause_physics")
+    wall_start = time.monotonic()
+    last_wall, last_sim = wall_start, start
+    watch = ["world", "controller"] + (["rosbag"] if args.bag else [])
+    while not recorder.reached.wait(PROGRESS_PERIOD):
+        session.check_running(watch)
+        now_wall, now_sim = time.monotonic(), recorder.sim_time or start
+        say(summary.progress_line(now_sim - start, args.duration,
+                                  summary.real_time_factor(now_sim - last_sim, now_wall - last_wall),
+                                  recorder.current_case()))
+        last_wall, last_sim = now_wall, now_sim
+    call_empty("/gazebo/pause_physics")
+    wall = time.monotonic() - wall_start
+    end = recorder.sim_time
+    say(summary.progress_line(end - start, args.duration, summary.real_time_factor(
+        end - start, wall), recorder.current_case()) + "  (run done)")
+    poses = model_poses()
+    time.sleep(0.3)          # the last queued messages arrive (physics is paused)
+    recorder.unregister()
+    return dict(recorder=recorder, urdf=urdf, start=start, end=end, wall=wall, poses=poses)
+
+
+def _wait_for_bag(session, timeout=15.0):
+    """Until rosbag record subscribes to every topic it was asked for."""
+    import rosgraph
+    master = rosgraph.Master("/m2wr_demo")
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        session.check_running(["rosbag"])
+        _, subscribers, _ = master.getSystemState()
+        subscribed = {topic for topic, nodes in subscribers
+                      if any(n.startswith("/record") for n in nodes)}
+        if all(t in subscribed for t in BAG_TOPICS):
+            return
+        time.sleep(0.1)
+    raise SessionError("rosbag record did not subscribe to %s within %.0f s; see %s"
+                       % (", ".join(BAG_TOPICS), timeout, session.child("rosbag").log_path))
+
+
+def analyse(args, data, paths):
+    """The offline part: clearance, picture, summary."""
+    import numpy as np
+    from demo_lib import picture
+    from demo_lib.scene import Scene
+    from pybullet_gazebo.engine.sdf_world import find_world, model_path_from_env
+    from pybullet_gazebo.engine.transforms import Pose
+    import rospkg
+
+    recorder, start, end = data["recorder"], data["start"], data["end"]
+    rospack = rospkg.RosPack()
+    world_path = find_world(args.world, os.path.join(rospack.get_path("my_worlds"), "worlds"))
+    model_path = model_path_from_env(os.path.join(rospack.get_path("pybullet_gazebo"), "models"))
+    scene = Scene(world_path, model_path, data["urdf"])
+    try:
+        scene.set_model_poses({n: p for n, p in data["poses"].items() if n != scene.robot_name})
+        track = np.array([p for p in recorder.poses if start - 1e-9 <= p[0] <= end + 1e-9]) \
+            .reshape(-1, 8)
+        robot_poses = [Pose(tuple(row[1:4]), tuple(row[4:8])) for row in track]
+        yaws = np.array([pose.rpy[2] for pose in robot_poses])
+        nearest = min(scene.clearance(robot_poses), key=lambda c: c.distance) \
+            if robot_poses else None
+        collisions = summary.collision_onsets(recorder.contacts)
+
+        def xy_at(t):
+            k = int(np.argmin(np.abs(track[:, 0] - t)))
+            return track[k, 1], track[k, 2], k
+        beams = None
+        scan = recorder.last_scan
+        if scan is not None and len(track):
+            _, _, k = xy_at(scan.header.stamp.to_sec())
+            sensor = scene.frame_pose(robot_poses[k], scan.header.frame_id)
+            beams = picture.beam_segments(sensor.position[:2], sensor.rpy[2], scan.angle_min,
+                                          scan.angle_increment, scan.ranges)
+        outlines = scene.outlines(SCAN_HEIGHT)
+    finally:
+        scene.close()
+    title = "%s: m2wr from (%.2f, %.2f) m, yaw %.0f deg; obstacle_avoidance.py for %.0f s sim" % (
+        world_label(args.world), args.x, args.y, math.degrees(args.yaw), end - start)
+    picture.draw(paths["picture"], outlines, track[:, 0] - start, track[:, 1], track[:, 2], yaws,
+                 beams=beams, collisions=[xy_at(c.sim_time)[:2] for c in collisions] if len(track) else [],
+                 title=title)
+    result = summary.RunSummary(
+        world=world_label(args.world), start=(args.x, args.y, args.yaw), sim_time=end - start,
+        wall_time=data["wall"], distance=summary.distance_travelled(track[:, 1:3]),
+        collisions=collisions,
+        cases=summary.case_durations(recorder.cases, start, end), picture=paths["picture"],
+        bag=paths["bag"] if args.bag else "")
+    if nearest is not None and math.isfinite(nearest.distance):
+        result.min_clearance = nearest.distance
+        result.min_clearance_model = nearest.model
+        result.min_clearance_time = float(track[nearest.index, 0] - start)
+    return result
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    out = os.path.abspath(args.output)
+    label = world_label(args.world)
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as err:
+        sys.stderr.write("demo: cannot create the output folder %s: %s\n" % (out, err.strerror))
+        return 1
+    paths = {"picture": os.path.join(out, "demo_%s.png" % label),
+             "summary": os.path.join(out, "demo_%s.json" % label),
+             "bag": os.path.join(out, "demo_%s.bag" % label)}
+    session = Session(os.path.join(out, "logs", "demo"), name="m2wr_demo")
+
+    def interrupt(signum, _frame):
+        raise Interrupted(signal.Signals(signum).name)
+    signal.signal(signal.SIGINT, interrupt)
+    signal.signal(signal.SIGTERM, interrupt)
+
+    status, data = 0, None
+    try:
+        data = run(args, session, paths)
+    except SessionError as err:
+        sys.stderr.write("demo: %s\n" % err)
+        status = 1
+    except Interrupted as err:
+        sys.stderr.write("demo: interrupted (%s); stopping everything\n" % err)
+        status = 130
+    except Exception as err:     # a ROS call failed: say which, then clean up
+        sys.stderr.write("demo: %s: %s\n" % (type(err).__name__, err))
+        status = 1
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)     # let the clean-up finish
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        try:
+            import rospy
+            if rospy.core.is_initialized():
+                rospy.signal_shutdown("demo finished")
+        except ImportError:
+            pass
+        say("stopping everything it started")
+        killed = session.stop_all()
+        if killed:
+            sys.stderr.write("demo: these processes outlived their parents and were killed:\n%s\n"
+                             % killed)
+        left = processes.leftovers(session.master_uri) if session.master_uri else []
+        if left:
+            sys.stderr.write("demo: processes still running after the clean-up:\n%s\n"
+                             % processes.describe(left))
+            status = status or 1
+        else:
+            say("all stopped (%s); no process left" % ", ".join(
+                "%s %s" % kv for kv in session.stop_report.items()))
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if status != 0:
+        return status
+    try:
+        result = analyse(args, data, paths)
+    except Exception as err:
+        sys.stderr.write("demo: the analysis of the run failed: %s: %s\n" % (type(err).__name__, err))
+        return 1
+    with open(paths["summary"], "w") as dump:
+        json.dump(result.as_dict(), dump, indent=2)
+    print(result.text(), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

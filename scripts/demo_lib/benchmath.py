@@ -1,0 +1,68 @@
+"""The benchmark's arithmetic and its side-by-side table, from plain numbers (no ROS)."""
+import math
+
+
+def rate(count, seconds):
+    """count / seconds, or nan when there was no time."""
+    return count / seconds if seconds > 0 else math.nan
+
+
+def growth_percent(start, end):
+    """How much `end` grew over `start` [%] (nan without a start)."""
+    if not start:
+        return math.nan
+    return 100.0 * (end - start) / start
+
+
+def stamp_rate(stamps):
+    """Messages per second of the stamps' own clock: (n - 1) / (last - first) for sorted,
+    distinct stamps [s] (nan for fewer than two)."""
+    stamps = sorted(set(stamps))
+    if len(stamps) < 2 or stamps[-1] <= stamps[0]:
+        return math.nan
+    return (len(stamps) - 1) / (stamps[-1] - stamps[0])
+
+
+def missing_periods(stamps, period, tolerance=0.25):
+    """How many messages are missing from a stream that should carry one stamp every
+    `period` [s]: gaps longer than (1 + tolerance) periods count (gap / period - 1) each."""
+    stamps = sorted(set(stamps))
+    missing = 0
+    for a, b in zip(stamps, stamps[1:]):
+        gap = b - a
+        if gap > (1.0 + tolerance) * period:
+            missing += int(round(gap / period)) - 1
+    return missing
+
+
+def every_scan_handled(scans, handled, missing):
+    """True when scans were published without a gap and the controller handled each one."""
+    return scans > 0 and missing == 0 and handled == scans
+
+
+def lockstep_verdict(scans, handled, answers, missing):
+    """One line: did the controller receive every scan the simulator published?
+    `handled` counts the controller's case lines (one per scan callback), `answers` the
+    cmd_vel messages heard, `missing` the gaps in the scans' stamps."""
+    if scans == 0:
+        return "no scans heard"
+    word = "yes" if every_scan_handled(scans, handled, missing) else "no"
+    return "%s: %d scans published, %d handled by the controller, %d cmd_vel answers, " \
+           "%d missing from the stream" % (word, scans, handled, answers, missing)
+
+
+def fmt(value, spec="%.1f"):
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "n/a"
+    return spec % value
+
+
+def table(header, rows, first_width=44):
+    """Left column of labels, then one right-aligned column per header entry."""
+    widths = [max(len(h), max((len(r[i + 1]) for r in rows), default=0)) + 2
+              for i, h in enumerate(header)]
+    lines = [" " * first_width + "".join(h.rjust(w) for h, w in zip(header, widths))]
+    for row in rows:
+        lines.append(row[0].ljust(first_width)
+                     + "".join(cell.rjust(w) for cell, w in zip(row[1:], widths)))
+    return "\n".join(lines)

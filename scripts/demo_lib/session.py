@@ -1,0 +1,245 @@
+"""One ROS session of the demo or the benchmark: its own master on a free localhost port,
+the simulator (my_worlds launch_world.launch), the robot (m2wr_description spawn.launch), the
+tutorial's controller (motion_plan obstacle_avoidance.py) and optionally rosbag, each a child
+process in a process group of its own with its output in <log_dir>/<name>.log.
+
+Every child gets ROS_MASTER_URI=http://localhost:<port> and ROS_HOSTNAME=localhost, and
+ROS_LOG_DIR=<log_dir>/ros; the caller's own ROS_MASTER_URI is never used, so a master the
+user runs is left alone. `stop()` ends the children (SIGINT, then SIGTERM, SIGKILL) and
+checks that no process of the session is left (`processes.leftovers`).
+"""
+import os
+import re
+import time
+import xmlrpc.client
+
+from . import processes
+
+NODE_SIMULATOR = "/gazebo"
+NODE_CONTROLLER = "/reading_laser"      # obstacle_avoidance.py's node name (the tutorial's)
+SCAN_TOPIC = "/m2wr/laser/scan"
+COMMAND_TOPIC = "/cmd_vel"
+
+
+class SessionError(RuntimeError):
+    """A step of the session failed; the message says which and why."""
+
+
+class Session:
+    def __init__(self, log_dir, name="demo"):
+        self.name = name
+        self.log_dir = os.path.abspath(log_dir)
+        os.makedirs(self.log_dir, exist_ok=True)
+        self.port = None
+        self.master_uri = None
+        self.env = None
+        self.children = {}                      # name -> processes.Child, in start order
+        self.stop_report = {}
+
+    # --- processes ----------------------------------------------------------------------
+    def _start(self, name, argv):
+        child = processes.Child(name, argv, self.env, os.path.join(self.log_dir, name + ".log"))
+        self.children[name] = child
+        return child
+
+    def child(self, name):
+        return self.children.get(name)
+
+    def start_master(self, timeout=20.0, attempts=3):
+        """roscore on a free port; returns the master's URI once it answers."""
+        for _ in range(attempts):
+            self.port = processes.free_port()
+            self.master_uri = "http://localhost:%d" % self.port
+            self.env = dict(os.environ, ROS_MASTER_URI=self.master_uri, ROS_HOSTNAME="localhost",
+                            ROS_LOG_DIR=os.path.join(self.log_dir, "ros"))
+            self.env.pop("ROS_IP", None)
+            roscore = self._start("roscore", ["roscore", "-p", str(self.port)])
+            deadline = time.monotonic() + timeout
+            while time.monotonic() < deadline and roscore.running():
+                if self.master_pid() is not None and self._rosout_up():
+                    return self.master_uri
+                time.sleep(0.1)
+            if roscore.running():
+                raise SessionError("roscore on port %d did not answer within %.0f s; see %s"
+                                   % (self.port, timeout, roscore.log_path))
+            del self.children["roscore"]      # the port was taken meanwhile: try another
+        raise SessionError("roscore would not start (%d attempts); last output:\n%s"
+                           % (attempts, roscore.log_tail()))
+
+    def master(self):
+        return xmlrpc.client.ServerProxy(self.master_uri)
+
+    def master_pid(self):
+        try:
+            code, _, pid = self.master().getPid("/" + self.name)
+            return pid if code == 1 else None
+        except (OSError, xmlrpc.client.Error):
+            return None
+
+    def _rosout_up(self):
+        return self.node_uri("/rosout") is not None
+
+    def node_uri(self, node):
+        try:
+            code, _, uri = self.master().lookupNode("/" + self.name, node)
+            return uri if code == 1 else None
+        except (OSError, xmlrpc.client.Error):
+            return None
+
+    def node_pid(self, node):
+        uri = self.node_uri(node)
+        if uri is None:
+            return None
+        try:
+            code, _, pid = xmlrpc.client.ServerProxy(uri).getPid("/" + self.name)
+            return pid if code == 1 else None
+        except (OSError, xmlrpc.client.Error):
+            return None
+
+    def launch_world(self, world, gui=False, real_time_factor=0.0, lockstep=True, seed=0,
+                     paused=False, pub_clock_frequency=None, extra=()):
+        args = ["roslaunch", "--sigint-timeout=10", "--sigterm-timeout=3", "my_worlds",
+                "launch_world.launch", "world:=%s" % world, "gui:=%s" % str(bool(gui)).lower(),
+                "real_time_factor:=%g" % real_time_factor,
+                "lockstep:=%s" % str(bool(lockstep)).lower(), "seed:=%d" % seed,
+                "pause:=%s" % str(bool(paused)).lower()]
+        if pub_clock_frequency is not None:
+            args.append("pub_clock_frequency:=%g" % pub_clock_frequency)
+        args.extend(extra)
+        return self._start("world", args)
+
+    def wait_for_simulator(self, timeout=60.0):
+        """Waits until /gazebo offers its spawn service; SessionError with the simulator's
+        own message when the launch ends first (e.g. an unknown world)."""
+        world = self.children["world"]
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if not world.running():
+                raise SessionError("the simulator stopped while starting (roslaunch exit %s):\n%s"
+                                   % (world.returncode, _problem_lines(world.log_tail(40))))
+            if self.service_offered("/gazebo/spawn_urdf_model"):
+                return
+            time.sleep(0.1)
+        raise SessionError("the simulator offered no /gazebo/spawn_urdf_model within %.0f s; "
+                           "see %s" % (timeout, world.log_path))
+
+    def service_offered(self, service):
+        try:
+            code, _, uri = self.master().lookupService("/" + self.name, service)
+            return code == 1
+        except (OSError, xmlrpc.client.Error):
+            return False
+
+    def spawn(self, x, y, yaw, timeout=60.0):
+        """roslaunch m2wr_description spawn.launch x:= y:= yaw:=; waits for it to end.
+        SessionError with its output unless it exits 0 without a node dying."""
+        self.start_spawn(x, y, yaw)
+        self.finish_spawn(timeout)
+
+    def start_spawn(self, x, y, yaw):
+        self._spawn_pose = (float(x), float(y), float(yaw))
+        return self._start("spawn", ["roslaunch", "m2wr_description", "spawn.launch",
+                                     "x:=%r" % float(x), "y:=%r" % float(y),
+                                     "yaw:=%r" % float(yaw)])
+
+    def finish_spawn(self, timeout=60.0):
+        """Waits for start_spawn's roslaunch; SessionError unless the spawn succeeded.
+        (roslaunch exits 0 even when its node failed, so its output is read too.)"""
+        child = self.children["spawn"]
+        x, y, yaw = self._spawn_pose
+        code = child.wait(timeout)
+        if code is None:
+            processes.stop([child], sigint_timeout=5.0)
+            raise SessionError("spawning m2wr did not finish within %.0f s:\n%s"
+                               % (timeout, child.log_tail()))
+        log = child.log_tail(60)
+        if code != 0 or "process has died" in log or "spawn_model:" in log:
+            raise SessionError("spawning m2wr at (%g, %g, yaw %g) failed (roslaunch exit %d):\n%s"
+                               % (x, y, yaw, code, _problem_lines(log)))
+
+    def start_controller(self):
+        return self._start("controller", ["rosrun", "motion_plan", "obstacle_avoidance.py"])
+
+    def start_bag(self, path, topics):
+        return self._start("rosbag", ["rosbag", "record", "--quiet", "-O", path] + list(topics))
+
+    # --- the graph ----------------------------------------------------------------------
+    def connected(self, node, topic, peer_node):
+        """True when `node` has a live connection on `topic` with `peer_node` (from the
+        node's getBusInfo)."""
+        uri, peer_uri = self.node_uri(node), self.node_uri(peer_node)
+        if uri is None or peer_uri is None:
+            return False
+        try:
+            code, _, bus = xmlrpc.client.ServerProxy(uri).getBusInfo("/" + self.name)
+        except (OSError, xmlrpc.client.Error):
+            return False
+        if code != 1:
+            return False
+        for connection in bus:
+            # [id, destination (caller id or URI), direction, transport, topic, connected, ...]
+            if len(connection) >= 6 and connection[4] == topic and connection[5] \
+                    and connection[1] in (peer_node, peer_uri):
+                return True
+        return False
+
+    def wait_for_controller(self, timeout=30.0):
+        """Until the simulator sends scans to the controller and hears its cmd_vel."""
+        controller = self.children["controller"]
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if not controller.running():
+                raise SessionError("obstacle_avoidance.py stopped while starting (exit %s):\n%s"
+                                   % (controller.returncode, controller.log_tail()))
+            if self.connected(NODE_SIMULATOR, SCAN_TOPIC, NODE_CONTROLLER) \
+                    and self.connected(NODE_SIMULATOR, COMMAND_TOPIC, NODE_CONTROLLER):
+                return
+            time.sleep(0.05)
+        raise SessionError("obstacle_avoidance.py did not connect to the simulator within %.0f s"
+                           "; see %s" % (timeout, controller.log_path))
+
+    def check_running(self, names):
+        """SessionError naming the first of `names` that is no longer running."""
+        for name in names:
+            child = self.children.get(name)
+            if child is not None and not child.running():
+                raise SessionError("%s stopped unexpectedly (exit %s):\n%s"
+                                   % (name, child.returncode, _problem_lines(child.log_tail(40))))
+
+    # --- the end ------------------------------------------------------------------------
+    def stop(self, names=None):
+        """Stops the named children (default: all), the controller and the bag before the
+        simulator and the simulator before the master. Returns {name: how it ended}."""
+        order = [["controller", "rosbag", "spawn"], ["world"], ["roscore"]]
+        names = set(self.children) if names is None else set(names)
+        for group in order + [[n for n in self.children if n not in sum(order, [])]]:
+            batch = [self.children[n] for n in group if n in names and n in self.children]
+            if batch:
+                self.stop_report.update(processes.stop(batch))
+                for child in batch:
+                    del self.children[child.name]
+        return self.stop_report
+
+    def stop_all(self):
+        """stop() everything, then make sure no process of the session is left. Returns the
+        `ps` lines of processes that had to be killed afterwards ("" when none)."""
+        self.stop()
+        if self.master_uri is None:
+            return ""
+        deadline = time.monotonic() + 3.0
+        while processes.leftovers(self.master_uri) and time.monotonic() < deadline:
+            time.sleep(0.1)      # nodes whose roslaunch just ended may still be exiting
+        return processes.kill_leftovers(self.master_uri)
+
+
+_ANSI = re.compile(r"\x1b(\[[0-9;]*[A-Za-z]|\][^\x07]*\x07)")
+
+
+def _problem_lines(text):
+    """The lines of a log that say what went wrong (or the whole tail when none does),
+    without terminal colour codes."""
+    text = _ANSI.sub("", text)
+    keys = ("error", "not found", "failed", "fatal", "exception", "no such", "cannot",
+            "invalid", "died", "spawn_model:", "gazebo_world:", "unknown", "traceback")
+    lines = [l for l in text.splitlines() if any(k in l.lower() for k in keys)]
+    return "\n".join(lines) if lines else text

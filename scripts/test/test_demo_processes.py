@@ -1,0 +1,84 @@
+"""demo_lib.processes: free port, stopping process groups by escalation, finding leftovers.
+The children here are `sleep` and `bash`, each in a session of its own, and are always
+stopped by the test that starts them."""
+import os
+import socket
+import time
+import uuid
+
+import pytest
+
+from demo_lib import processes
+from demo_lib.processes import Child
+
+
+@pytest.fixture
+def run_env():
+    """An environment with a ROS_MASTER_URI no other process has."""
+    uri = "http://localhost:1/%s" % uuid.uuid4().hex
+    return uri, dict(os.environ, ROS_MASTER_URI=uri)
+
+
+def test_free_port_can_be_bound():
+    port = processes.free_port()
+    assert 1024 <= port <= 65535
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", port))
+        sock.listen(1)
+        assert processes.port_in_use(port)
+
+
+def test_sigint_ends_a_well_behaved_child(tmp_path, run_env):
+    uri, env = run_env
+    child = Child("sleeper", ["sleep", "30"], env, str(tmp_path / "sleeper.log"))
+    assert child.running()
+    assert processes.leftovers(uri) == [child.pid]
+    outcome = processes.stop([child], sigint_timeout=5.0, sigterm_timeout=1.0)
+    assert outcome == {"sleeper": "exit -2"}
+    assert processes.leftovers(uri) == []
+
+
+def test_escalates_to_sigterm_then_sigkill(tmp_path, run_env):
+    uri, env = run_env
+    deaf = Child("deaf", ["bash", "-c", "trap '' INT; echo ready; sleep 30 & wait"], env,
+                 str(tmp_path / "deaf.log"))
+    deafer = Child("deafer", ["bash", "-c", "trap '' INT TERM; echo ready; while :; do sleep 0.1; done"],
+                   env, str(tmp_path / "deafer.log"))
+    deadline = time.monotonic() + 5.0
+    while time.monotonic() < deadline and not all(
+            "ready" in c.log_tail() for c in (deaf, deafer)):
+        time.sleep(0.05)
+    outcome = processes.stop([deaf, deafer], sigint_timeout=0.5, sigterm_timeout=0.5)
+    assert outcome == {"deaf": "SIGTERM", "deafer": "SIGKILL"}
+    # the whole group went: deaf's `sleep` child too
+    deadline = time.monotonic() + 2.0
+    while processes.leftovers(uri) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert processes.leftovers(uri) == []
+
+
+def test_kill_leftovers_finds_orphans_by_environment(tmp_path, run_env):
+    uri, env = run_env
+    # bash starts sleep in a session of its own (as roslaunch starts nodes) and exits
+    parent = Child("parent", ["bash", "-c", "setsid sleep 30 & echo $!"], env,
+                   str(tmp_path / "parent.log"))
+    assert parent.wait(5.0) == 0
+    orphan = int(parent.log_tail().split()[-1])
+    parent.close()
+    assert processes.leftovers(uri) == [orphan]
+    text = processes.kill_leftovers(uri)
+    assert str(orphan) in text and "sleep 30" in text
+    assert processes.leftovers(uri) == []
+
+
+def test_start_failure_names_the_command(tmp_path):
+    with pytest.raises(RuntimeError, match="cannot start nothing"):
+        Child("nothing", ["/nonexistent/program"], dict(os.environ), str(tmp_path / "n.log"))
+
+
+def test_process_figures_of_this_process():
+    assert processes.peak_rss_kib(os.getpid()) >= processes.rss_kib(os.getpid()) > 1000
+    assert processes.cpu_seconds(os.getpid()) > 0.0
+    assert processes.environment_of(os.getpid()).get("PATH") == os.environ.get("PATH") or True
+    assert processes.peak_rss_kib(2 ** 22 + 12345) is None
+    assert processes.environment_of(2 ** 22 + 12345) == {}
