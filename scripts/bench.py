@@ -144,6 +144,10 @@ class Listener:
                                                queue_size=10000, tcp_nodelay=True))
             self._subs.append(rospy.Subscriber("/rosout", Log, self._on_log, queue_size=10000))
 
+    def snapshot(self):
+        """(scans heard, cmd_vel answers, controller case lines) so far."""
+        return len(self.scan_stamps), self.answers, self.callbacks
+
     def stop_counting(self):
         for sub in self._subs:
             sub.unregister()
@@ -224,18 +228,21 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         cpu1 = (processes.cpu_seconds(sim_pid), processes.cpu_seconds(ctrl_pid))
         session.check_running(["world", "controller"])
         sim_s, wall_s = sim1 - sim0, wall1 - wall0
-        # the scan/answer count: a window that starts and ends paused
-        call_empty("/gazebo/pause_physics")
+        # the scan/answer count: a window that starts and ends paused, with the counters
+        # connected beforehand (/rosout is latched: its last line arrives on connecting)
         listener.count()
         wait_counting(session)
-        time.sleep(0.5)
+        call_empty("/gazebo/pause_physics")
+        time.sleep(1.0)                       # answers in flight arrive
+        before = listener.snapshot()
         call_empty("/gazebo/unpause_physics")
         time.sleep(check_seconds)
         call_empty("/gazebo/pause_physics")
-        time.sleep(1.0)                       # the last answer arrives
+        time.sleep(1.0)
+        after = listener.snapshot()
         listener.stop_counting()
-        scans, answers, handled = len(listener.scan_stamps), listener.answers, listener.callbacks
-        missing = benchmath.missing_periods(listener.scan_stamps, SCAN_PERIOD)
+        scans, answers, handled = (a - b for a, b in zip(after, before))
+        missing = benchmath.missing_periods(listener.scan_stamps[before[0]:after[0]], SCAN_PERIOD)
         peak = processes.peak_rss_kib(sim_pid)
         with open(session.children["world"].log_path, errors="replace") as log:
             timeouts = sum("lockstep: no cmd_vel" in line for line in log)
@@ -247,7 +254,8 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         "cpu_ms_per_sim_s": {
             "simulator": 1e3 * (cpu1[0] - cpu0[0]) / sim_s if sim_s > 0 else None,
             "controller": 1e3 * (cpu1[1] - cpu0[1]) / sim_s if sim_s > 0 else None},
-        "check": {"scans": scans, "handled_by_controller": handled, "cmd_vel_answers": answers,
+        "check": {"scans_published": scans + missing, "scans_heard": scans,
+                  "handled_by_controller": handled, "cmd_vel_answers": answers,
                   "missing_scans": missing,
                   "every_scan_received": benchmath.every_scan_handled(scans, handled, missing),
                   "verdict": benchmath.lockstep_verdict(scans, handled, answers, missing),
@@ -291,6 +299,8 @@ def soak(session, listener, minutes, clock_hz):
     try:
         listener.count(scans=True, commands=True)
         wait_counting(session)
+        time.sleep(1.0)                       # the latched /rosout line arrives
+        before = listener.snapshot()
         call_empty("/gazebo/unpause_physics")
         time.sleep(5.0)
         rss0, sim0, wall0 = processes.rss_kib(sim_pid), listener.sim_time, time.monotonic()
@@ -304,8 +314,9 @@ def soak(session, listener, minutes, clock_hz):
         call_empty("/gazebo/pause_physics")
         time.sleep(1.0)
         listener.stop_counting()
-        stamps = listener.scan_stamps
-        answers, handled = listener.answers, listener.callbacks
+        after = listener.snapshot()
+        stamps = listener.scan_stamps[before[0]:after[0]]
+        answers, handled = after[1] - before[1], after[2] - before[2]
     finally:
         stop_loop(session)
     errors = error_lines(session.log_dir)
@@ -354,7 +365,8 @@ def report(figures):
                                            for n in names]),
         ("  controller CPU per sim s [ms]", [fmt(loops[n]["cpu_ms_per_sim_s"]["controller"], "%.0f")
                                             for n in names]),
-        ("scans published in the check window", [str(loops[n]["check"]["scans"]) for n in names]),
+        ("scans published in the check window", [str(loops[n]["check"]["scans_published"])
+                                                 for n in names]),
         ("  handled by the controller", [str(loops[n]["check"]["handled_by_controller"])
                                          for n in names]),
         ("  cmd_vel answers heard", [str(loops[n]["check"]["cmd_vel_answers"]) for n in names]),

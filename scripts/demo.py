@@ -35,6 +35,7 @@ from demo_lib.session import Session, SessionError      # noqa: E402
 BAG_TOPICS = ("/m2wr/laser/scan", "/odom", "/cmd_vel")
 SCAN_HEIGHT = 0.15          # [m] the laser's plane above the ground, where obstacles are cut
 PROGRESS_PERIOD = 2.0       # [s] wall
+CLEARANCE_RANGE = 50.0      # [m] obstacles farther than this count as none
 DEFAULT_CLOCK_HZ = 20.0     # [Hz] sim; the simulator also publishes /clock with every scan
 
 
@@ -134,19 +135,21 @@ def run(args, session, paths):
     session.launch_world(args.world, gui=args.gui, real_time_factor=1.0 if realtime else 0.0,
                          lockstep=not realtime, seed=args.seed, paused=True,
                          pub_clock_frequency=args.clock_hz)
-    # the three start together (physics is paused): spawn_model waits for the simulator's
-    # service, and the controller for scans; each is checked in turn below
-    say("spawning m2wr at x %g y %g yaw %g; starting obstacle_avoidance.py"
-        % (args.x, args.y, args.yaw))
+    # spawn_model starts at once (it waits for the simulator's service); the controller
+    # once the simulator is up, so that /use_sim_time is set when it starts, while the
+    # robot is being spawned (physics is paused until everything is connected)
+    say("spawning m2wr at x %g y %g yaw %g" % (args.x, args.y, args.yaw))
     session.start_spawn(args.x, args.y, args.yaw)
-    session.start_controller()
     session.wait_for_simulator()
+    say("starting obstacle_avoidance.py")
+    session.start_controller()
     session.finish_spawn()
     urdf = rospy.get_param("/robot_description")
     if args.bag:
         session.start_bag(paths["bag"], BAG_TOPICS)
-        _wait_for_bag(session)
     session.wait_for_controller()
+    if args.bag:
+        _wait_for_bag(session)
     say("m2wr spawned, obstacle_avoidance.py connected; running")
 
     start = recorder.sim_time or 0.0
@@ -164,29 +167,31 @@ def run(args, session, paths):
         last_wall, last_sim = now_wall, now_sim
     call_empty("/gazebo/pause_physics")
     wall = time.monotonic() - wall_start
-    end = recorder.sim_time
-    say(summary.progress_line(end - start, args.duration, summary.real_time_factor(
-        end - start, wall), recorder.current_case()) + "  (run done)")
     poses = model_poses()
     time.sleep(0.3)          # the last queued messages arrive (physics is paused)
     recorder.unregister()
+    end = recorder.sim_time
+    say(summary.progress_line(end - start, args.duration, summary.real_time_factor(
+        end - start, wall), recorder.current_case()) + "  (run done)")
     return dict(recorder=recorder, urdf=urdf, start=start, end=end, wall=wall, poses=poses)
 
 
 def _wait_for_bag(session, timeout=15.0):
-    """Until rosbag record subscribes to every topic it was asked for."""
+    """Until rosbag record is connected to the publishers of every topic it records (the
+    simulator's scan and odometry, the controller's cmd_vel), so the bag starts at 0 s."""
     import rosgraph
     master = rosgraph.Master("/m2wr_demo")
+    publishers = {"/m2wr/laser/scan": "/gazebo", "/odom": "/gazebo",
+                  "/cmd_vel": "/reading_laser"}
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         session.check_running(["rosbag"])
         _, subscribers, _ = master.getSystemState()
-        subscribed = {topic for topic, nodes in subscribers
-                      if any(n.startswith("/record") for n in nodes)}
-        if all(t in subscribed for t in BAG_TOPICS):
+        recorders = {n for _, nodes in subscribers for n in nodes if n.startswith("/record")}
+        if any(all(session.connected(publishers[t], t, r) for t in BAG_TOPICS) for r in recorders):
             return
         time.sleep(0.1)
-    raise SessionError("rosbag record did not subscribe to %s within %.0f s; see %s"
+    raise SessionError("rosbag record did not connect to %s within %.0f s; see %s"
                        % (", ".join(BAG_TOPICS), timeout, session.child("rosbag").log_path))
 
 
@@ -210,7 +215,8 @@ def analyse(args, data, paths):
             .reshape(-1, 8)
         robot_poses = [Pose(tuple(row[1:4]), tuple(row[4:8])) for row in track]
         yaws = np.array([pose.rpy[2] for pose in robot_poses])
-        nearest = min(scene.clearance(robot_poses), key=lambda c: c.distance) \
+        nearest = min(scene.clearance(robot_poses, max_distance=CLEARANCE_RANGE),
+                      key=lambda c: c.distance) \
             if robot_poses else None
         collisions = summary.collision_onsets(recorder.contacts)
 

@@ -35,20 +35,22 @@ def missing_periods(stamps, period, tolerance=0.25):
     return missing
 
 
-def every_scan_handled(scans, handled, missing):
-    """True when scans were published without a gap and the controller handled each one."""
-    return scans > 0 and missing == 0 and handled == scans
+def every_scan_handled(heard, handled, missing):
+    """True when the controller handled every scan the simulator published: `heard` scans
+    reached the bench, `missing` more are gaps in their stamps (published, not heard by the
+    bench), `handled` counts the controller's case lines (one per scan callback)."""
+    published = heard + missing
+    return published > 0 and handled == published
 
 
-def lockstep_verdict(scans, handled, answers, missing):
-    """One line: did the controller receive every scan the simulator published?
-    `handled` counts the controller's case lines (one per scan callback), `answers` the
-    cmd_vel messages heard, `missing` the gaps in the scans' stamps."""
-    if scans == 0:
+def lockstep_verdict(heard, handled, answers, missing):
+    """One line: did the controller receive every scan the simulator published?"""
+    published = heard + missing
+    if published == 0:
         return "no scans heard"
-    word = "yes" if every_scan_handled(scans, handled, missing) else "no"
-    return "%s: %d scans published, %d handled by the controller, %d cmd_vel answers, " \
-           "%d missing from the stream" % (word, scans, handled, answers, missing)
+    word = "yes" if every_scan_handled(heard, handled, missing) else "no"
+    return "%s: %d scans published (%d heard by the bench), %d handled by the controller, " \
+           "%d cmd_vel answers" % (word, published, heard, handled, answers)
 
 
 def fmt(value, spec="%.1f"):

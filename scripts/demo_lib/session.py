@@ -239,6 +239,8 @@ def _problem_lines(text):
     """The lines of a log that say what went wrong (or the whole tail when none does),
     without terminal colour codes."""
     text = _ANSI.sub("", text)
+    text = "\n".join(l.lstrip("=") for l in text.splitlines()
+                     if "symlink to latest log directory" not in l)
     keys = ("error", "not found", "failed", "fatal", "exception", "no such", "cannot",
             "invalid", "died", "spawn_model:", "gazebo_world:", "unknown", "traceback")
     lines = [l for l in text.splitlines() if any(k in l.lower() for k in keys)]

@@ -79,6 +79,6 @@ def test_start_failure_names_the_command(tmp_path):
 def test_process_figures_of_this_process():
     assert processes.peak_rss_kib(os.getpid()) >= processes.rss_kib(os.getpid()) > 1000
     assert processes.cpu_seconds(os.getpid()) > 0.0
-    assert processes.environment_of(os.getpid()).get("PATH") == os.environ.get("PATH") or True
+    assert "PATH" in processes.environment_of(os.getpid())
     assert processes.peak_rss_kib(2 ** 22 + 12345) is None
     assert processes.environment_of(2 ** 22 + 12345) == {}
