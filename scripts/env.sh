@@ -7,7 +7,11 @@ if [ ! -f "$_m2wr_root/catkin_ws/devel/setup.bash" ]; then
   echo "env.sh: $_m2wr_root/catkin_ws/devel/setup.bash not found; run scripts/setup.sh first" >&2
   return 1 2>/dev/null || exit 1
 fi
-source "$_m2wr_root/catkin_ws/devel/setup.bash"
+# sourced from a function called without arguments: catkin's setup.sh would otherwise take
+# the caller's own arguments (e.g. a script's --help) as its own
+_m2wr_source() { source "$_m2wr_root/catkin_ws/devel/setup.bash"; }
+_m2wr_source
+unset -f _m2wr_source
 export PATH="$_m2wr_root/.venv/bin:$PATH"
 export VIRTUAL_ENV="$_m2wr_root/.venv"
 # ROS stays on this machine unless the user already chose otherwise.

@@ -28,7 +28,8 @@ python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib --junit
 if [ "$mode" != "--unit" ]; then
   for ws in simulation_ws catkin_ws; do
     echo "[test] rostest suites of $ws (catkin_make run_tests, one at a time)"
-    set +u; source "$ROOT/$ws/devel/setup.bash"; set -u
+    source_ws() { source "$ROOT/$ws/devel/setup.bash"; }   # without this script's arguments
+    set +u; source_ws; set -u
     export PATH="$ROOT/.venv/bin:$PATH"
     (cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 2>&1) > "$RESULTS/$ws-run_tests.log"
     # one progress line per suite; the full output stays in the log

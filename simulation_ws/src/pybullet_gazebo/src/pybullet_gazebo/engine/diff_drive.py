@@ -194,6 +194,13 @@ class DiffDrive:
         self._fresh = True
         return True
 
+    def next_update_time(self):
+        """Sim time [s] of the next update, at which a command is read; a command set before
+        the step that starts at this time takes effect then."""
+        if self._control.last is None:
+            return 0.0
+        return self._control.last + self._control.period - _TOLERANCE
+
     def wheel_speeds(self, linear_x, angular_z):
         """Target speeds [rad/s] of (leftJoint, rightJoint) for a command, before clamping."""
         half = angular_z * self.wheel_separation / 2.0

@@ -139,6 +139,13 @@ class World:
         self._track_contacts(robots)
         return readings
 
+    def next_command_time(self):
+        """Earliest sim time [s] at which a drive next reads its command (None: no drive).
+        A command given before the step starting at that time is used from then on."""
+        times = [c.next_update_time() for robot in self.robots() for c in robot.components
+                 if hasattr(c, "next_update_time")]
+        return min(times) if times else None
+
     @staticmethod
     def _read(component, now):
         return component.measure(now) if hasattr(component, "measure") else component.odometry()

@@ -63,6 +63,7 @@ class SimulatorNode:
         # publication periods in whole physics steps, so they never drift
         self._clock_every = self._steps_per_period(params.pub_clock_frequency)
         self._last_clock_step = 0
+        self._awaited = None     # lockstep: (commands counted at a scan, sim time needed by)
         self._model_states_every = self._steps_per_period(params.model_states_rate)
 
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) \
@@ -125,6 +126,10 @@ class SimulatorNode:
             if self.paused:
                 time.sleep(0.01)
                 continue
+            awaited = self._awaited
+            if awaited is not None and self.world.sim_time >= awaited[1]:
+                self._wait_for_command(awaited[0])
+                self._awaited = None
             with self.lock:
                 readings = self.world.step()
                 commands_before = self.commands_received
@@ -133,8 +138,11 @@ class SimulatorNode:
                 self._publish_clock(stamp, force=bool(readings))
                 scans = self._publish_readings(readings, stamp)
                 self._publish_world(stamp)
-            if scans and self.params.lockstep:
-                self._wait_for_command(commands_before)
+                needed_at = self.world.next_command_time() if scans else None
+            if self.params.lockstep and needed_at is not None:
+                # The drive reads its command only at its next update (Gazebo's plugin does
+                # the same), so physics runs on until then while the controller thinks.
+                self._awaited = (commands_before, needed_at)
             self._pace(now)
 
     def _publish_clock(self, stamp, force):
@@ -190,7 +198,8 @@ class SimulatorNode:
         return msg
 
     def _wait_for_command(self, commands_before):
-        """Lockstep: hold physics until a controller answers the scan (if one listens)."""
+        """Lockstep: hold physics until a controller has answered the last scan (if one
+        listens), so the answer reaches the drive at the same sim time on every run."""
         if not any(s.get_num_connections() for _, subs in self._robot_io.values() for s in subs):
             return
         deadline = time.monotonic() + self.params.lockstep_timeout
@@ -220,6 +229,7 @@ class SimulatorNode:
 
     def after_reset(self):
         self._reset_pacing()
+        self._awaited = None
 
     def shutdown(self):
         try:
