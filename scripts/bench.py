@@ -483,20 +483,7 @@ def main(argv=None):
         sys.stderr.write("bench: %s: %s\n" % (type(err).__name__, err))
         status = 1
     finally:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        try:
-            import rospy
-            if rospy.core.is_initialized():
-                rospy.signal_shutdown("bench finished")
-        except ImportError:
-            pass
-        killed = session.stop_all()
-        if killed:
-            sys.stderr.write("bench: these processes outlived their parents and were killed:\n%s\n"
-                             % killed)
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        session.shut_down("bench")
     figures["machine"]["load_after"] = "%.2f" % os.getloadavg()[0]
     figures["status"] = "ok" if status == 0 else "failed"
     path = os.path.join(out, "bench.json")

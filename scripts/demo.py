@@ -283,19 +283,8 @@ def main(argv=None):
         sys.stderr.write("demo: %s: %s\n" % (type(err).__name__, err))
         status = 1
     finally:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)     # let the clean-up finish
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        try:
-            import rospy
-            if rospy.core.is_initialized():
-                rospy.signal_shutdown("demo finished")
-        except ImportError:
-            pass
         say("stopping everything it started")
-        killed = session.stop_all()
-        if killed:
-            sys.stderr.write("demo: these processes outlived their parents and were killed:\n%s\n"
-                             % killed)
+        session.shut_down("demo")
         left = processes.leftovers(session.master_uri) if session.master_uri else []
         if left:
             sys.stderr.write("demo: processes still running after the clean-up:\n%s\n"
@@ -304,8 +293,6 @@ def main(argv=None):
         else:
             say("all stopped (%s); no process left" % ", ".join(
                 "%s %s" % kv for kv in session.stop_report.items()))
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if status != 0:
         return status
     try:

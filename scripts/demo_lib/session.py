@@ -10,6 +10,8 @@ checks that no process of the session is left (`processes.leftovers`).
 """
 import os
 import re
+import sys
+import signal
 import time
 import xmlrpc.client
 
@@ -219,6 +221,25 @@ class Session:
                 for child in batch:
                     del self.children[child.name]
         return self.stop_report
+
+    def shut_down(self, tool):
+        """The end of a run of `tool` (demo, bench), whatever happened: signals are held off
+        while this process's ROS node and everything the session started are stopped. Reports
+        on stderr any process that had to be killed afterwards."""
+        signal.signal(signal.SIGINT, signal.SIG_IGN)     # let the clean-up finish
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        try:
+            import rospy
+            if rospy.core.is_initialized():
+                rospy.signal_shutdown("%s finished" % tool)
+        except ImportError:
+            pass
+        killed = self.stop_all()
+        if killed:
+            sys.stderr.write("%s: these processes outlived their parents and were killed:\n%s\n"
+                             % (tool, killed))
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
     def stop_all(self):
         """stop() everything, then make sure no process of the session is left. Returns the

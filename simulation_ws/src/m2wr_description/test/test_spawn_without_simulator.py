@@ -9,12 +9,17 @@ import rospy
 import rostest
 
 
+def spawn(param, *extra):
+    """Runs our spawn_model client on a description parameter; returns the finished process."""
+    return subprocess.run(["rosrun", "pybullet_gazebo", "spawn_model", "-urdf", "-param", param,
+                           "-model", "m2wr"] + list(extra),
+                          capture_output=True, text=True, timeout=40)
+
+
 class SpawnWithoutSimulatorTest(unittest.TestCase):
     def test_gives_up_within_ten_seconds_and_says_what_to_do(self):
         started = time.monotonic()
-        result = subprocess.run(["rosrun", "pybullet_gazebo", "spawn_model", "-urdf", "-param",
-                                 "robot_description", "-model", "m2wr", "-y", "8"],
-                                capture_output=True, text=True, timeout=40)
+        result = spawn("robot_description", "-y", "8")
         elapsed = time.monotonic() - started
         self.assertEqual(result.returncode, 1)
         self.assertLess(elapsed, 12.0)           # 10 s of waiting plus start-up
@@ -23,17 +28,13 @@ class SpawnWithoutSimulatorTest(unittest.TestCase):
 
     def test_empty_description_is_refused(self):
         rospy.set_param("/empty_description", "")
-        result = subprocess.run(["rosrun", "pybullet_gazebo", "spawn_model", "-urdf", "-param",
-                                 "empty_description", "-model", "m2wr"],
-                                capture_output=True, text=True, timeout=40)
+        result = spawn("empty_description")
         self.assertEqual(result.returncode, 1)
         self.assertIn("empty", result.stderr)
 
     def test_malformed_description_is_refused_with_its_line(self):
         rospy.set_param("/broken_description", "<robot name='m2wr'>\n<link name='a'>\n</robot>")
-        result = subprocess.run(["rosrun", "pybullet_gazebo", "spawn_model", "-urdf", "-param",
-                                 "broken_description", "-model", "m2wr"],
-                                capture_output=True, text=True, timeout=40)
+        result = spawn("broken_description")
         self.assertEqual(result.returncode, 1)
         self.assertIn("not valid XML (line 3", result.stderr)
 

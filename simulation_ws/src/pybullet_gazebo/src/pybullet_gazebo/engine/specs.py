@@ -3,7 +3,7 @@
 into Bullet bodies and components by `world.World`.
 """
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, Optional, Tuple
 
 from .transforms import Pose
 

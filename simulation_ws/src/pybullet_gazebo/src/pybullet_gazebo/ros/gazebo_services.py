@@ -13,7 +13,6 @@ from gazebo_msgs.srv import (DeleteModel, DeleteModelResponse, GetModelState,
                              SpawnModel, SpawnModelResponse)
 from geometry_msgs.msg import Vector3
 
-from pybullet_gazebo.engine.transforms import Pose
 from pybullet_gazebo.ros import conversions
 
 WORLD_FRAMES = ("", "world", "map")
