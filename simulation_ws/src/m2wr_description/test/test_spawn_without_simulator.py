@@ -22,7 +22,7 @@ class SpawnWithoutSimulatorTest(unittest.TestCase):
         result = spawn("robot_description", "-y", "8")
         elapsed = time.monotonic() - started
         self.assertEqual(result.returncode, 1)
-        self.assertLess(elapsed, 12.0)           # 10 s of waiting plus start-up
+        self.assertLess(elapsed, 14.0)           # 10 s of waiting plus start-up under load
         self.assertIn("launch_world.launch", result.stderr)
         self.assertIn("start the world", result.stderr)
 
