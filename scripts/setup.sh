@@ -27,7 +27,7 @@ APT_PACKAGES=(
   libnav-msgs-dev python3-nav-msgs python3-rosgraph-msgs python3-tf2-ros python3-tf2-msgs
   python3-rospy python3-rostest python3-rosunit librostest-dev python3-roslaunch
   python3-rosmaster rosout rosbash python3-rostopic python3-rosservice python3-rosnode
-  python3-rosparam python3-rosmsg python3-rosbag
+  python3-rosparam python3-rosmsg python3-rosbag ros-robot-state-publisher
 )
 
 STEP="check machine"
