@@ -12,6 +12,7 @@ parameters (~name), with units:
   lockstep_timeout    [s] of wall time to wait for it before stepping on
   cmd_vel_timeout     [s] of sim time after which a robot stops without commands; 0 = never
   gui                 open pybullet's GUI window (needs a display)
+  debug               log at debug level (read by nodes/gazebo_world)
 Global: /use_sim_time (publish /clock).
 """
 from dataclasses import dataclass
