@@ -78,6 +78,9 @@ def test_kill_leftovers_finds_orphans_by_environment(tmp_path, run_env):
     assert parent.wait(5.0) == 0
     orphan = int(parent.log_tail().split()[-1])
     parent.close()
+    deadline = time.monotonic() + 5.0        # while it execs, its /proc entry is in flux
+    while time.monotonic() < deadline and not exec_done(orphan, b"sleep"):
+        time.sleep(0.01)
     assert processes.leftovers(uri) == [orphan]
     text = processes.kill_leftovers(uri)
     assert str(orphan) in text and "sleep 30" in text
