@@ -12,7 +12,7 @@ parameters (~name), with units:
   lockstep_timeout    [s] of wall time to wait for it before stepping on
   cmd_vel_timeout     [s] of sim time after which a robot stops without commands; 0 = never
   gui                 open pybullet's GUI window (needs a display)
-  debug               log at debug level (read by nodes/gazebo_world)
+  debug               log at debug level
 Global: /use_sim_time (publish /clock).
 """
 from dataclasses import dataclass
@@ -39,6 +39,7 @@ class SimulatorParams:
     lockstep_timeout: float = 1.0           # [s] wall
     cmd_vel_timeout: float = 0.0            # [s] sim
     gui: bool = False
+    debug: bool = False
 
     def __post_init__(self):
         def check(name, value, low, allow_zero=True):
@@ -80,4 +81,5 @@ class SimulatorParams:
             lockstep_timeout=get("lockstep_timeout", defaults.lockstep_timeout, float),
             cmd_vel_timeout=get("cmd_vel_timeout", defaults.cmd_vel_timeout, float),
             gui=get("gui", defaults.gui, bool),
+            debug=get("debug", defaults.debug, bool),
         )

@@ -110,8 +110,9 @@ class SimulatorNode:
             rospy.logwarn_throttle(5.0, "ignored a %s command for '%s' with NaN or inf: %s"
                                    % (drive.command_topic, name, [msg.linear.x, msg.angular.z]))
         else:
-            rospy.logdebug_throttle(1.0, "%s for '%s': linear.x %.3f, angular.z %.3f"
-                                    % (drive.command_topic, name, msg.linear.x, msg.angular.z))
+            if self.params.debug:          # a per-message hot path: no work when not asked
+                rospy.logdebug_throttle(1.0, "%s for '%s': linear.x %.3f, angular.z %.3f"
+                                        % (drive.command_topic, name, msg.linear.x, msg.angular.z))
             with self.lock:
                 drive.set_command(msg.linear.x, msg.angular.z)
         with self.command_arrived:
