@@ -161,12 +161,12 @@ class Scene:
         result = []
         client = self.client
         for name in self.obstacles():
-            for body in self.world.entities[name].body_ids:
+            entity = self.world.entities[name]
+            for body, shapes in zip(entity.body_ids, entity.shapes):
                 base_position, base_orientation = client.getBasePositionAndOrientation(body)
                 base = Pose(tuple(base_position), tuple(base_orientation))
-                for entry in client.getCollisionShapeData(body, -1):
-                    geometry, dims, local = entry[2], entry[3], Pose(tuple(entry[5]), tuple(entry[6]))
-                    shape = base.compose(local)
+                for geometry, dims, local_position, local_orientation in shapes:
+                    shape = base.compose(Pose(tuple(local_position), tuple(local_orientation)))
                     position, rotation = np.asarray(shape.position), rotation_matrix(shape.orientation)
                     outline = None
                     if geometry == pybullet.GEOM_BOX:

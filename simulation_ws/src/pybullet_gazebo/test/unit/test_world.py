@@ -213,3 +213,41 @@ def test_same_seed_and_commands_give_identical_runs(make_world, m2wr_urdf):
     assert poses_a == poses_b
     assert np.array_equal(scans_a, scans_b)
     assert not np.array_equal(scans_a, scans_c)             # the noise follows the seed
+
+
+def test_dynamic_world_models_keep_their_sdf_mass_and_inertia_and_stay_at_rest(make_world):
+    world = make_world("world02")
+    dynamic = [m for m in world_spec("world02").models if not m.static]
+    assert {m.name for m in dynamic} >= {"coke_can", "construction_barrel"}
+    start = {m.name: world.model_pose(m.name).position for m in dynamic}
+    for model in dynamic:
+        mass, _, inertia = world.client.getDynamicsInfo(world.entity(model.name).body_ids[0],
+                                                        -1)[:3]
+        assert mass == pytest.approx(model.links[0].inertial.mass)
+        assert inertia == pytest.approx(model.links[0].inertial.inertia)
+    run(world, 2.0)
+    for model in dynamic:
+        assert world.model_pose(model.name).position == pytest.approx(start[model.name],
+                                                                      abs=1e-3)
+
+
+def test_the_ground_is_only_tested_against_models_that_can_move(make_world):
+    world = make_world("world02")
+    run(world, 0.1)
+    ground = world.entity("ground_plane").body_ids[0]
+    owner = {body: name for name in world.model_names() for body in world.entity(name).body_ids}
+    touching = {owner[point[2]] for point in world.client.getContactPoints(bodyA=ground)}
+    assert "coke_can" in touching
+    assert [name for name in touching if world.entity(name).static] == []
+
+
+def test_the_laser_sees_a_static_model_where_set_model_state_put_it(make_world, m2wr_urdf):
+    world = make_world("world02")
+    robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(-6, 2, 0.5))   # open floor
+    run(world, 0.5)
+    laser = component(robot, RaySensor)
+    ahead = len(laser.measure(world.sim_time).ranges) // 2           # the beam along +x
+    assert laser.measure(world.sim_time).ranges[ahead] > 3.0
+    assert world.entity("jersey_barrier").static
+    world.set_model_state("jersey_barrier", Pose.from_xyz_rpy(-4.0, 2.0, 0.0, 0, 0, math.pi / 2))
+    assert 1.2 < laser.measure(world.sim_time).ranges[ahead] < 2.0

@@ -158,19 +158,28 @@ class RayCaster:
         self._dynamic_groups = {}             # exclude_body -> _Group of the other dynamics
 
     # --- the set of bodies --------------------------------------------------------------
-    def add_body(self, body_id, static):
+    def add_body(self, body_id, static, base_shapes=None):
         """Read every collision shape of every link of `body_id`. A static body's shapes are
-        placed in the world now and cached: add it again (or call reset) after moving it."""
+        placed in the world now and cached: add it again (or call reset) after moving it.
+        `base_shapes` gives the shapes of a body with a base and no links instead, for the
+        bodies whose shapes pybullet cannot report (those made with useMaximalCoordinates):
+        (geometry type, dimensions, local position, local orientation) each, as
+        getCollisionShapeData reports them."""
         self.remove_body(body_id)
         client = self._client
+        if base_shapes is not None:
+            shapes_per_link = [(-1, base_shapes)]
+        else:
+            # an entry: (body, link, geometry type, dimensions, file, local pos, local orn);
+            # body/link of the 2nd+ entries of a link are unreliable in pybullet 3.2.
+            shapes_per_link = [(link, [(e[2], e[3], e[5], e[6])
+                                       for e in client.getCollisionShapeData(body_id, link)])
+                               for link in range(-1, client.getNumJoints(body_id))]
         kinds, rows, positions, rotations, sizes, planes, links = [], [], [], [], [], [], []
-        for link in range(-1, client.getNumJoints(body_id)):
+        for link, entries in shapes_per_link:
             row = len(links)
             used = False
-            for entry in client.getCollisionShapeData(body_id, link):
-                # entry: (body, link, geometry type, dimensions, file, local pos, local orn);
-                # body/link of the 2nd+ entries of a link are unreliable in pybullet 3.2.
-                geometry, dims, pos, orn = entry[2], entry[3], entry[5], entry[6]
+            for geometry, dims, pos, orn in entries:
                 rot = rotation_matrices(orn)[0]
                 if geometry == _PLANE:
                     normal = np.asarray(dims, dtype=float)

@@ -3,9 +3,12 @@ the components their `<gazebo>` tags ask for, fixed-step stepping, and what Gaze
 services need (model states, reset, delete, contacts).
 
 Frames: a model's pose is its model frame in the world, as Gazebo reports it. A world model
-becomes one Bullet body per link; a robot is one Bullet multibody loaded from its URDF, whose
-model frame is its root link's frame. Bullet reports a body's inertial (centre-of-mass)
-frame; `_link_frame` converts.
+becomes one Bullet body per link: a rigid body in maximal coordinates (world02 steps 15 %
+faster than with multibodies), or a multibody when it holds a plane (pybullet cannot report a
+maximal body's shapes, and the ground checks read the plane back). A robot is one Bullet multibody loaded from its URDF,
+whose model frame is its root link's frame. Bullet reports a body's inertial (centre-of-mass)
+frame; `_link_frame` converts, with the offsets kept in the Entity (pybullet 3.2 reports
+garbage for a maximal body's inertial frame).
 """
 from dataclasses import dataclass, field
 import math
@@ -60,10 +63,14 @@ class Entity:
     name: str
     body_ids: List[int]
     link_offsets: List[Pose]        # each body's link frame in the model frame
+    inertial_offsets: List[Pose]    # each body's inertial frame in its link frame
     initial_pose: Pose              # model frame in the world at load/spawn
     static: bool
     is_ground: bool = False
     robot: Optional[Robot] = None
+    # a world model's collision shapes per body, as getCollisionShapeData reports them
+    # (which pybullet cannot do for maximal bodies): see _shape_data. Empty for a robot.
+    shapes: List[list] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -166,8 +173,7 @@ class World:
 
     def model_pose(self, name) -> Pose:
         entity = self.entity(name)
-        body = entity.body_ids[0]
-        return self._link_frame(body).compose(entity.link_offsets[0].inverse())
+        return self._link_frame(entity, 0).compose(entity.link_offsets[0].inverse())
 
     def model_twist(self, name):
         """(linear, angular) velocity of the model's first body, world frame [m/s], [rad/s]."""
@@ -191,9 +197,11 @@ class World:
             raise ValueError("orientation of '%s' is a zero quaternion; nothing changed" % name)
         pose = Pose(pose.position, tuple(q / norm for q in pose.orientation))
         entity = self.entity(name)
-        for body, offset in zip(entity.body_ids, entity.link_offsets):
-            self._place(body, pose.compose(offset))
+        for index, body in enumerate(entity.body_ids):
+            self._place(entity, index, pose.compose(entity.link_offsets[index]))
             self.client.resetBaseVelocity(body, list(linear), list(angular))
+        if entity.static:
+            self.caster.reset()             # it caches static shapes where they were
         if entity.robot is not None:
             for index in entity.robot.joints.values():
                 self.client.resetJointState(entity.body_ids[0], index, 0.0, 0.0)
@@ -271,7 +279,9 @@ class World:
             raise
         for message in spec.warnings:
             self.warn("model '%s': %s" % (name, message))
-        self.entities[name] = Entity(name, [body], [Pose()], pose, static=False, robot=robot)
+        inertial = Pose(*self.client.getDynamicsInfo(body, -1)[3:5])   # reliable for multibodies
+        self.entities[name] = Entity(name, [body], [Pose()], [inertial], pose, static=False,
+                                     robot=robot)
         self._body_owner[body] = name
         self.caster.add_body(body, static=False)
         return robot
@@ -417,7 +427,7 @@ class World:
 
     # --- building world models ------------------------------------------------------------
     def _add_world_model(self, model):
-        bodies, offsets = [], []
+        bodies, offsets, inertials, shapes = [], [], [], []
         all_planes = True
         for link in model.links:
             collisions = [c for c in link.collisions if not isinstance(c.geometry, Mesh)]
@@ -427,18 +437,21 @@ class World:
             body = self._create_link_body(model, link, collisions)
             bodies.append(body)
             offsets.append(link.pose)
+            inertials.append(link.inertial.pose)
+            shapes.append([_shape_data(c, link.inertial.pose) for c in collisions])
         if not bodies:
             self.warn("model '%s' has no collision the stand-in can simulate; it is not in the "
                       "physics world" % model.name)
             return
-        entity = Entity(model.name, bodies, offsets, model.pose, model.static, is_ground=all_planes)
+        entity = Entity(model.name, bodies, offsets, inertials, model.pose, model.static,
+                        is_ground=all_planes, shapes=shapes)
         self.entities[model.name] = entity
-        for body in bodies:
+        for body, body_shapes in zip(bodies, shapes):
             self._body_owner[body] = model.name
             if all_planes:
                 wheel_contact.mark_ground(self.client, body)
             else:
-                self.caster.add_body(body, static=model.static)
+                self.caster.add_body(body, static=model.static, base_shapes=body_shapes)
 
     def _create_link_body(self, model, link, collisions):
         client = self.client
@@ -458,10 +471,12 @@ class World:
             baseMass=mass, baseCollisionShapeIndex=shape,
             basePosition=world_pose.position, baseOrientation=world_pose.orientation,
             baseInertialFramePosition=inertial.pose.position,
-            baseInertialFrameOrientation=inertial.pose.orientation)
+            baseInertialFrameOrientation=inertial.pose.orientation,
+            useMaximalCoordinates=not any(isinstance(c.geometry, Plane) for c in collisions))
         if mass > 0.0:
             # Gazebo lets resting bodies sleep (auto-disable); so does Bullet, when asked
-            client.changeDynamics(body, -1, localInertiaDiagonal=list(inertial.inertia),
+            # (the mass again: without it pybullet 3.2 sets a maximal body's mass to 0 -> NaN)
+            client.changeDynamics(body, -1, mass=mass, localInertiaDiagonal=list(inertial.inertia),
                                   activationState=pybullet.ACTIVATION_STATE_ENABLE_SLEEPING)
         client.changeDynamics(body, -1, lateralFriction=collisions[0].mu)
         return body
@@ -490,14 +505,34 @@ class World:
         kwargs["collisionFrameOrientations"].append(list(collision.pose.orientation))
 
     # --- frames -------------------------------------------------------------------------
-    def _link_frame(self, body) -> Pose:
-        """World pose of a body's base link frame (Bullet reports its inertial frame)."""
-        position, orientation = self.client.getBasePositionAndOrientation(body)
-        local_position, local_orientation = self.client.getDynamicsInfo(body, -1)[3:5]
+    def _link_frame(self, entity, index) -> Pose:
+        """World pose of the link frame of an entity's `index`th body (Bullet reports its
+        inertial frame)."""
+        position, orientation = self.client.getBasePositionAndOrientation(entity.body_ids[index])
         inertial = Pose(tuple(position), tuple(orientation))
-        return inertial.compose(Pose(tuple(local_position), tuple(local_orientation)).inverse())
+        return inertial.compose(entity.inertial_offsets[index].inverse())
 
-    def _place(self, body, link_pose: Pose):
-        local_position, local_orientation = self.client.getDynamicsInfo(body, -1)[3:5]
-        inertial = link_pose.compose(Pose(tuple(local_position), tuple(local_orientation)))
-        self.client.resetBasePositionAndOrientation(body, inertial.position, inertial.orientation)
+    def _place(self, entity, index, link_pose: Pose):
+        inertial = link_pose.compose(entity.inertial_offsets[index])
+        self.client.resetBasePositionAndOrientation(entity.body_ids[index], inertial.position,
+                                                    inertial.orientation)
+
+
+def _shape_data(collision, inertial_pose):
+    """A collision as pybullet's getCollisionShapeData reports one: (geometry type,
+    dimensions, position, orientation), the pose in the link's inertial frame. The caster
+    needs it for the bodies whose shapes pybullet cannot report."""
+    geometry = collision.geometry
+    if isinstance(geometry, Box):
+        kind, dimensions = pybullet.GEOM_BOX, tuple(geometry.size)
+    elif isinstance(geometry, Cylinder):
+        kind, dimensions = pybullet.GEOM_CYLINDER, (geometry.length, geometry.radius, 0.0)
+    elif isinstance(geometry, Sphere):
+        kind, dimensions = pybullet.GEOM_SPHERE, (geometry.radius,) * 3
+    elif isinstance(geometry, Plane):
+        kind, dimensions = pybullet.GEOM_PLANE, tuple(geometry.normal)
+    else:
+        raise ValueError("collision '%s': geometry %r is not supported"
+                         % (collision.name, geometry))
+    local = inertial_pose.inverse().compose(collision.pose)
+    return kind, dimensions, local.position, local.orientation
