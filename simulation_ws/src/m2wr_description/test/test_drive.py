@@ -18,6 +18,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from std_srvs.srv import Empty
 from gazebo_msgs.srv import GetModelState
+from tf2_msgs.msg import TFMessage
 
 from pybullet_gazebo.ros.testing import service, unwrap_angle, wait_for_message, wait_until_sim_time
 
@@ -114,6 +115,38 @@ class DriveTest(unittest.TestCase):
         self.cmd.publish(Twist())
         self.assertAlmostEqual(odom.twist.twist.linear.x, 0.6, delta=0.05)
         self.assertLess(abs(odom.twist.twist.linear.y), 0.05)
+
+    def test_5_tf_odom_to_chassis_is_the_odometry_pose_at_20_hz(self):
+        odometry, transforms = {}, []
+        odom_sub = rospy.Subscriber("/odom", Odometry,
+                                    lambda m: odometry.__setitem__(m.header.stamp, m))
+        tf_sub = rospy.Subscriber("/tf", TFMessage, lambda m: transforms.extend(m.transforms))
+        command = Twist()
+        command.linear.x, command.angular.z = 0.3, 0.2
+        self.cmd.publish(command)
+        try:
+            wait_until_sim_time(rospy.get_time() + 2.0)
+        finally:
+            self.cmd.publish(Twist())
+            odom_sub.unregister()
+            tf_sub.unregister()
+        chassis = [t for t in transforms if t.child_frame_id == "link_chassis"]
+        self.assertGreater(len(chassis), 20, "odom -> link_chassis on /tf")
+        stamps = [t.header.stamp.to_sec() for t in chassis]
+        for earlier, later in zip(stamps, stamps[1:]):
+            self.assertAlmostEqual(later - earlier, 0.05, delta=1e-6)      # updateRate 20
+        matched = 0
+        for transform in chassis:
+            self.assertEqual(transform.header.frame_id, "odom")
+            odom = odometry.get(transform.header.stamp)
+            if odom is None:
+                continue
+            matched += 1
+            pose, moved = odom.pose.pose, transform.transform
+            self.assertEqual((moved.translation.x, moved.translation.y, moved.translation.z),
+                             (pose.position.x, pose.position.y, pose.position.z))
+            self.assertEqual(moved.rotation, pose.orientation)
+        self.assertGreater(matched, 20)
 
 
 if __name__ == "__main__":

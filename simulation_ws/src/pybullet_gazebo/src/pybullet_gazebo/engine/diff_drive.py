@@ -41,7 +41,7 @@ import math
 import numpy as np
 import pybullet
 
-from .transforms import Pose
+from .transforms import Pose, cross
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
 
@@ -292,10 +292,11 @@ class DiffDrive:
         client = self._client
         com_position, com_orientation = client.getBasePositionAndOrientation(self.body_id)
         link = Pose(com_position, com_orientation).compose(self._base_inertial.inverse())
-        linear, angular = (np.asarray(v, dtype=float)
-                           for v in client.getBaseVelocity(self.body_id))
+        linear, angular = client.getBaseVelocity(self.body_id)
         # velocity of the link frame's origin, from the centre of mass's
-        linear = linear + np.cross(angular, np.asarray(link.position) - np.asarray(com_position))
+        lever = cross(angular, [a - b for a, b in zip(link.position, com_position)])
+        linear = np.array(linear) + lever
+        angular = np.array(angular)
         to_base = link.matrix.T
         return Odometry(link, to_base @ linear, to_base @ angular)
 

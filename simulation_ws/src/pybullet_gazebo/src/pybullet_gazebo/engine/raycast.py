@@ -28,6 +28,8 @@ shape. Distances are measured from the origin [m]; no hit is `inf`.
 import numpy as np
 import pybullet
 
+from .transforms import cross
+
 _SPHERE, _BOX, _CYLINDER, _CAPSULE = 0, 1, 2, 3      # internal shape kinds, sorted order
 _KINDS = {pybullet.GEOM_SPHERE: _SPHERE, pybullet.GEOM_BOX: _BOX,
           pybullet.GEOM_CYLINDER: _CYLINDER, pybullet.GEOM_CAPSULE: _CAPSULE}
@@ -122,9 +124,11 @@ class _Group:
             self.planes += [(body.body_id, row + offset, p, n) for row, p, n in body.planes]
             offset += len(body.links)
         self.shapes = _Shapes.concatenate(self.shapes) if self.shapes else None
+        self._last = (None, None)            # (poses read, what place returned for them)
 
     def place(self, client):
-        """(_Shapes or None, [(body, point, normal)]) at the bodies' present poses."""
+        """(_Shapes or None, [(body, point, normal)]) at the bodies' present poses; the same
+        objects as last time when no body moved (resting bodies sleep and do not)."""
         if not self.bodies:
             return None, []
         positions, orientations = [], []
@@ -138,11 +142,14 @@ class _Group:
                                                   computeForwardKinematics=1):
                     positions.append(state[0])
                     orientations.append(state[1])
+        if (positions, orientations) == self._last[0]:
+            return self._last[1]
         position = np.asarray(positions, dtype=float)
         rotation = rotation_matrices(orientations)
         planes = [(body_id, position[row] + rotation[row] @ p, rotation[row] @ n)
                   for body_id, row, p, n in self.planes]
         shapes = self.shapes.placed(position, rotation) if self.shapes is not None else None
+        self._last = ((positions, orientations), (shapes, planes))
         return shapes, planes
 
 
@@ -156,6 +163,7 @@ class RayCaster:
         self._static_placed = {}              # body id -> its shapes and planes in the world
         self._static_cache = None             # all static shapes and planes in the world
         self._dynamic_groups = {}             # exclude_body -> _Group of the other dynamics
+        self._joined = (None, None, None)     # (static, dynamic, both in one _Shapes)
 
     # --- the set of bodies --------------------------------------------------------------
     def add_body(self, body_id, static, base_shapes=None):
@@ -269,14 +277,22 @@ class RayCaster:
             if body_id != exclude_body:
                 np.minimum(result, self._plane_hits(origin, directions, point, normal,
                                                     range_min, range_max), out=result)
-        shapes = [s for s in (static_shapes, dynamic_shapes) if s is not None]
-        if shapes:
-            shapes = _Shapes.concatenate(shapes) if len(shapes) > 1 else shapes[0]
+        shapes = self._join(static_shapes, dynamic_shapes)
+        if shapes is not None:
             with np.errstate(divide="ignore", invalid="ignore"):
                 hits = self._shape_hits(origin, directions, shapes, range_min, range_max,
                                         exclude_body)
             np.minimum(result, hits, out=result)
         return result
+
+    def _join(self, static_shapes, dynamic_shapes):
+        """Both sets in one _Shapes (or None); reused while neither changed."""
+        if self._joined[0] is static_shapes and self._joined[1] is dynamic_shapes:
+            return self._joined[2]
+        parts = [s for s in (static_shapes, dynamic_shapes) if s is not None]
+        joined = (_Shapes.concatenate(parts) if len(parts) > 1 else parts[0]) if parts else None
+        self._joined = (static_shapes, dynamic_shapes, joined)
+        return joined
 
     @staticmethod
     def _plane_hits(origin, directions, point, normal, range_min, range_max):
@@ -287,11 +303,17 @@ class RayCaster:
 
     @staticmethod
     def _coplanar_normal(directions):
-        """Unit normal of the plane holding every direction, or None."""
+        """Unit normal of the plane holding every (unit) direction, or None: the first
+        direction crossed with the one most nearly perpendicular to it, checked on all."""
         if len(directions) < 2:
             return None
-        _, vectors = np.linalg.eigh(directions.T @ directions)
-        normal = vectors[:, 0]
+        first = directions[0]
+        other = directions[np.argmin(np.abs(directions @ first))]
+        normal = np.array(cross(first, other))
+        length = np.sqrt(normal @ normal)
+        if length < 1e-6:                          # all (anti)parallel: no single plane
+            return None
+        normal /= length
         if np.max(np.abs(directions @ normal)) > 1e-9:
             return None
         return normal
@@ -354,11 +376,10 @@ def _support(shapes, normal):
     local = np.abs(normal @ shapes.rotation)                      # |normal| in shape frames
     r, h = shapes.size[:, 0], shapes.size[:, 1]
     axial = local[:, 2]
-    return np.select(
-        [shapes.kind == _BOX, shapes.kind == _CYLINDER, shapes.kind == _CAPSULE],
-        [(local * shapes.size) @ _ONES,
-         r * np.sqrt(np.maximum(0.0, 1.0 - axial * axial)) + h * axial,
-         r + h * axial], r)
+    kind = shapes.kind
+    round_ = np.where(kind == _CYLINDER, r * np.sqrt(np.maximum(0.0, 1.0 - axial * axial)),
+                      r) + np.where(kind == _SPHERE, 0.0, h * axial)
+    return np.where(kind == _BOX, (local * shapes.size) @ _ONES, round_)
 
 
 def _sphere_pairs(directions, relative, distance, bound, range_min, range_max):
@@ -375,7 +396,7 @@ def _fan_pairs(directions, normal, kind, relative, rotation, size):
     origin with unit `normal`: each shape's projection on that plane spans an angle seen from
     the origin, and only the rays inside that angle are paired with it."""
     u = directions[0]
-    v = np.cross(normal, u)
+    v = np.array(cross(normal, u))
     ray_angle = np.arctan2(directions @ v, directions @ u)
     order = np.argsort(ray_angle, kind="stable")
     sorted_angle = ray_angle[order]

@@ -108,6 +108,7 @@ class World:
         self.contact_events: List[ContactEvent] = []
         self._touching = set()                       # (robot, other) pairs touching now
         self._body_owner: Dict[int, str] = {}
+        self._robots: Optional[List[Robot]] = None  # cache of robots()
         self.caster = RayCaster(client)
 
         client.resetSimulation()
@@ -162,7 +163,9 @@ class World:
         return list(self.entities)
 
     def robots(self) -> List[Robot]:
-        return [e.robot for e in self.entities.values() if e.robot is not None]
+        if self._robots is None:         # stepped 200 times a second: kept until one comes or goes
+            self._robots = [e.robot for e in self.entities.values() if e.robot is not None]
+        return list(self._robots)
 
     def entity(self, name) -> Entity:
         try:
@@ -213,6 +216,7 @@ class World:
             self.client.removeBody(body)
             self._body_owner.pop(body, None)
         del self.entities[name]
+        self._robots = None
         self._touching = {pair for pair in self._touching if name not in pair}
 
     def reset_world(self):
@@ -280,6 +284,7 @@ class World:
         for message in spec.warnings:
             self.warn("model '%s': %s" % (name, message))
         inertial = Pose(*self.client.getDynamicsInfo(body, -1)[3:5])   # reliable for multibodies
+        self._robots = None
         self.entities[name] = Entity(name, [body], [Pose()], [inertial], pose, static=False,
                                      robot=robot)
         self._body_owner[body] = name

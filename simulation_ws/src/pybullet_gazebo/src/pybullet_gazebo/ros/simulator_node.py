@@ -14,9 +14,11 @@ Topics out:
   per robot, from its <gazebo> tags: the laser's topicName (sensor_msgs/LaserScan) at the
   sensor's update_rate, the diff drive's odometryTopic (nav_msgs/Odometry) and TF
   odometryFrame -> robotBaseFrame at its updateRate.
-Topics in: per robot, the diff drive's commandTopic (geometry_msgs/Twist).
+Topics in: per robot, the diff drive's commandTopic (geometry_msgs/Twist). Not /clock: the
+node is its source (see nodes/gazebo_world).
 Parameters: see params.py. All messages of one step carry that step's sim time; wall-clock
-pacing (real_time_factor, lockstep) lives here, never in the engine.
+pacing (real_time_factor, lockstep) lives here, never in the engine. Odometry and TF messages
+are built only while someone listens (the engine computes the odometry either way).
 """
 import os
 import threading
@@ -24,12 +26,12 @@ import time
 
 import pybullet
 import rospy
-import tf2_ros
 from geometry_msgs.msg import Twist
 from gazebo_msgs.msg import ContactState, ContactsState, ModelStates
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
+from tf2_msgs.msg import TFMessage
 from pybullet_utils.bullet_client import BulletClient
 
 from pybullet_gazebo.engine.diff_drive import DiffDrive
@@ -70,7 +72,7 @@ class SimulatorNode:
             if params.use_sim_time else None
         self.model_states_pub = rospy.Publisher("~model_states", ModelStates, queue_size=1)
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100, latch=True)
-        self.tf_broadcaster = tf2_ros.TransformBroadcaster()
+        self.tf_pub = rospy.Publisher("/tf", TFMessage, queue_size=100)
         self.services = GazeboServices(self)
         rospy.loginfo("world '%s' loaded from %s: %d models, physics step %.4f s, "
                       "real_time_factor %s%s", world_spec.name, world_spec.source,
@@ -136,11 +138,8 @@ class SimulatorNode:
             with self.lock:
                 readings = self.world.step()
                 commands_before = self.commands_received
-                stamp = conversions.stamp_of(self.world.step_count, self.world.step_size)
                 now = self.world.sim_time
-                self._publish_clock(stamp, force=bool(readings))
-                scans = self._publish_readings(readings, stamp)
-                self._publish_world(stamp)
+                scans = self._publish(readings)
                 needed_at = self.world.next_command_time() if scans else None
             if self.params.lockstep and needed_at is not None:
                 # The drive reads its command only at its next update (Gazebo's plugin does
@@ -148,16 +147,38 @@ class SimulatorNode:
                 self._awaited = (commands_before, needed_at)
             self._pace(now)
 
-    def _publish_clock(self, stamp, force):
+    def _publish(self, readings):
+        """Publishes what is due after a step, stamped with its sim time; returns the number
+        of scans published."""
+        touching = self.world.touching()
+        contacts_changed = touching != self._last_touching
+        model_states_due = self.world.step_count % self._model_states_every == 0 \
+            and self.model_states_pub.get_num_connections() > 0     # costly: only if heard
+        clock_due = self._clock_due(force=bool(readings))
+        if not (readings or contacts_changed or model_states_due or clock_due):
+            return 0
+        stamp = conversions.stamp_of(self.world.step_count, self.world.step_size)
+        if clock_due:
+            self.clock_pub.publish(Clock(stamp))
+        scans = self._publish_readings(readings, stamp)
+        if contacts_changed:
+            self._last_touching = touching
+            self._publish_contacts(touching, stamp)
+        if model_states_due:
+            self.model_states_pub.publish(self.model_states())
+        return scans
+
+    def _clock_due(self, force):
         """/clock every _clock_every steps and on each step with readings (`force`), counted
         from the last /clock sent: the two cadences share ticks instead of adding up (at
         20 Hz, /clock would otherwise go out at 40 Hz, its ticks between the scans')."""
         if self.clock_pub is None:
-            return
+            return False
         since = self.world.step_count - self._last_clock_step
         if force or since >= self._clock_every or since < 0:     # < 0: after a reset
             self._last_clock_step = self.world.step_count
-            self.clock_pub.publish(Clock(stamp))
+            return True
+        return False
 
     def _publish_readings(self, readings, stamp):
         scans = 0
@@ -170,26 +191,25 @@ class SimulatorNode:
                 publisher.publish(conversions.scan_to_msg(reading.data, stamp))
                 scans += 1
             else:
+                odometry_heard = publisher.get_num_connections() > 0
+                tf_heard = reading.component.publish_odom_tf and self.tf_pub.get_num_connections() > 0
+                if not (odometry_heard or tf_heard):
+                    continue
                 odometry, transform = conversions.odometry_to_msgs(
                     reading.data, reading.component, stamp)
-                publisher.publish(odometry)
-                if reading.component.publish_odom_tf:
-                    self.tf_broadcaster.sendTransform(transform)
+                if odometry_heard:
+                    publisher.publish(odometry)
+                if tf_heard:
+                    self.tf_pub.publish(TFMessage([transform]))
         return scans
 
-    def _publish_world(self, stamp):
-        touching = self.world.touching()
-        if touching != self._last_touching:
-            self._last_touching = touching
-            msg = ContactsState()
-            msg.header.stamp = stamp
-            msg.header.frame_id = "world"
-            msg.states = [ContactState(info="%s touches %s" % pair, collision1_name=pair[0],
-                                       collision2_name=pair[1]) for pair in touching]
-            self.contacts_pub.publish(msg)
-        if self.world.step_count % self._model_states_every == 0 \
-                and self.model_states_pub.get_num_connections() > 0:   # costly: only if heard
-            self.model_states_pub.publish(self.model_states())
+    def _publish_contacts(self, touching, stamp):
+        msg = ContactsState()
+        msg.header.stamp = stamp
+        msg.header.frame_id = "world"
+        msg.states = [ContactState(info="%s touches %s" % pair, collision1_name=pair[0],
+                                   collision2_name=pair[1]) for pair in touching]
+        self.contacts_pub.publish(msg)
 
     def model_states(self):
         msg = ModelStates()
