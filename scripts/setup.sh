@@ -70,8 +70,8 @@ if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
 else
   say "3/4 PyPI packages: installing requirements.txt (pybullet is a ~100 MB wheel)"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r "$ROOT/requirements.txt"
-  "$VENV/bin/python" -c "import rospy, pybullet, numpy, xacro" \
-    || fail "the venv cannot import rospy, pybullet, numpy and xacro together"
+  "$VENV/bin/python" -c "import rospy, pybullet, numpy, numba, xacro" \
+    || fail "the venv cannot import rospy, pybullet, numpy, numba and xacro together"
   echo "$want" > "$stamp"
 fi
 
@@ -89,6 +89,14 @@ build_ws simulation_ws
 # catkin_ws overlays simulation_ws, as in the tutorial's environment where both are sourced.
 set +u; source "$ROOT/simulation_ws/devel/setup.bash"; set -u
 build_ws catkin_ws
+
+STEP="ray caster compile"
+# numba compiles the laser's inner loop once and caches it beside its source; doing it here
+# keeps that second out of the first simulator start
+seconds="$("$VENV/bin/python" -c \
+  "from pybullet_gazebo.engine import ray_kernel; print('%.1f' % ray_kernel.warm_up())")" \
+  || fail "numba could not compile pybullet_gazebo/engine/ray_kernel.py (error above)"
+say "4/4 ray caster compiled or loaded from numba's cache in $seconds s"
 
 STEP="done"
 say "ready: run 'source scripts/env.sh' to use roscore, roslaunch and rosrun"

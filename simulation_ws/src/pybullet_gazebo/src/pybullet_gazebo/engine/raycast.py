@@ -1,12 +1,12 @@
-"""Exact ray casting against Bullet's primitive collision shapes, in numpy.
+"""Exact ray casting against Bullet's primitive collision shapes.
 
-Bullet's own `rayTestBatch` costs about 3 ms for a 720-beam scan; this caster costs about
-0.5 ms in the tutorial's world02. It reads the bodies' collision shapes once, keeps static
-ones in world coordinates, reads dynamic ones' poses at each cast, and then, for all rays at
-once: drops shapes out of range or (when the rays share a plane, as a laser's do) not
-crossing that plane; pairs each remaining shape with the rays that can reach it (the rays
-inside the angle its projection spans, or else those meeting its bounding sphere); and
-solves the exact slab (box) or quadric (sphere, cylinder, capsule) intersection per pair.
+Bullet's own `rayTestBatch` costs about 3 ms for a 720-beam scan; this caster about 0.1 ms in
+the tutorial's world02. It reads the bodies' collision shapes once, keeps static ones in world
+coordinates (numpy arrays), reads dynamic ones' poses at each cast, and hands all shapes and
+rays to the compiled kernel `ray_kernel.nearest_hits`. That one drops shapes out of range or
+(when the rays share a plane, as a laser's do) not crossing that plane, skips the rays that
+miss a shape's bounding sphere, and solves the exact slab (box) or quadric (sphere,
+cylinder, capsule) intersection for the rest.
 
 Shapes read from `client.getCollisionShapeData(body, link)` (pybullet's conventions, checked
 against `client.rayTest`):
@@ -28,13 +28,14 @@ shape. Distances are measured from the origin [m]; no hit is `inf`.
 import numpy as np
 import pybullet
 
+from . import ray_kernel
 from .transforms import cross
 
-_SPHERE, _BOX, _CYLINDER, _CAPSULE = 0, 1, 2, 3      # internal shape kinds, sorted order
+_SPHERE, _BOX, _CYLINDER, _CAPSULE = (ray_kernel.SPHERE, ray_kernel.BOX, ray_kernel.CYLINDER,
+                                      ray_kernel.CAPSULE)
 _KINDS = {pybullet.GEOM_SPHERE: _SPHERE, pybullet.GEOM_BOX: _BOX,
           pybullet.GEOM_CYLINDER: _CYLINDER, pybullet.GEOM_CAPSULE: _CAPSULE}
 _PLANE = pybullet.GEOM_PLANE
-_PARALLEL = 1e-12          # squared sine below which a ray counts as parallel to an axis
 _ONES = np.ones(3)         # row sums as a matrix product, much faster than .sum(axis=1)
 
 
@@ -65,19 +66,19 @@ class _Shapes:
     FIELDS = ("body", "kind", "link_row", "position", "rotation", "size", "bound")
 
     def __init__(self, **arrays):
-        for name in self.FIELDS:
-            setattr(self, name, arrays[name])
+        for name in self.FIELDS:      # contiguous: the kernel is compiled for that layout
+            setattr(self, name, np.ascontiguousarray(arrays[name]))
 
     @classmethod
     def of_body(cls, body, kind, link_row, position, rotation, size):
         n = len(kind)
-        kind = np.asarray(kind, dtype=int).reshape(n)
+        kind = np.asarray(kind, dtype=np.int64).reshape(n)
         size = np.asarray(size, dtype=float).reshape(n, 3)
         r, h = size[:, 0], size[:, 1]
         bound = np.select([kind == _BOX, kind == _CYLINDER, kind == _CAPSULE],
                           [np.sqrt((size * size) @ _ONES), np.hypot(r, h), r + h], r)
-        return cls(body=np.full(n, body, dtype=int), kind=kind,
-                   link_row=np.asarray(link_row, dtype=int).reshape(n),
+        return cls(body=np.full(n, body, dtype=np.int64), kind=kind,
+                   link_row=np.asarray(link_row, dtype=np.int64).reshape(n),
                    position=np.asarray(position, dtype=float).reshape(n, 3),
                    rotation=np.asarray(rotation, dtype=float).reshape(n, 3, 3),
                    size=size, bound=bound)
@@ -279,10 +280,12 @@ class RayCaster:
                                                     range_min, range_max), out=result)
         shapes = self._join(static_shapes, dynamic_shapes)
         if shapes is not None:
-            with np.errstate(divide="ignore", invalid="ignore"):
-                hits = self._shape_hits(origin, directions, shapes, range_min, range_max,
-                                        exclude_body)
-            np.minimum(result, hits, out=result)
+            normal = self._coplanar_normal(directions)
+            ray_kernel.nearest_hits(origin, directions, _NO_PLANE if normal is None else normal,
+                                    shapes.kind, shapes.position, shapes.rotation, shapes.size,
+                                    shapes.bound, shapes.body,
+                                    -1 if exclude_body is None else int(exclude_body),
+                                    range_min, range_max, result)
         return result
 
     def _join(self, static_shapes, dynamic_shapes):
@@ -318,210 +321,5 @@ class RayCaster:
             return None
         return normal
 
-    def _shape_hits(self, origin, directions, shapes, range_min, range_max, exclude_body):
-        """Nearest hit [m] of each (unit) direction on `shapes` (placed), inf if none."""
-        # cull whole shapes: too far, inside the dead zone, off the rays' common plane
-        relative = shapes.position - origin                      # (k, 3)
-        distance = np.sqrt((relative * relative) @ _ONES)
-        keep = (distance - shapes.bound <= range_max) & (distance + shapes.bound >= range_min)
-        if exclude_body is not None:
-            keep &= shapes.body != exclude_body
-        normal = self._coplanar_normal(directions)
-        if normal is not None:
-            keep &= np.abs(relative @ normal) <= _support(shapes, normal)
-        index = np.flatnonzero(keep)
-        result = np.full(len(directions), np.inf)
-        if len(index) == 0:
-            return result
-        index = index[np.argsort(shapes.kind[index], kind="stable")]   # grouped by kind
-        kind = shapes.kind[index]
-        relative, rotation, size = relative[index], shapes.rotation[index], shapes.size[index]
 
-        # candidate ray-shape pairs, sorted by shape
-        if normal is not None:
-            shape_of, ray_of = _fan_pairs(directions, normal, kind, relative, rotation, size)
-        else:
-            shape_of, ray_of = _sphere_pairs(directions, relative, distance[index],
-                                             shapes.bound[index], range_min, range_max)
-        if len(shape_of) == 0:
-            return result
-
-        # rays in the shapes' frames: every direction in every shape frame by one product,
-        # then gathered per pair; components kept as separate contiguous arrays
-        k = len(kind)
-        local = (directions @ rotation.transpose(1, 0, 2).reshape(3, 3 * k)).ravel()
-        flat = ray_of * (3 * k) + 3 * shape_of
-        d = (local[flat], local[flat + 1], local[flat + 2])
-        origin_local = np.einsum("kji,kj->ik", rotation, -relative)   # (3, k)
-        o = (origin_local[0][shape_of], origin_local[1][shape_of], origin_local[2][shape_of])
-        size_t = size.T.copy()
-        first_pair = np.searchsorted(shape_of, np.searchsorted(kind, np.arange(5)))
-        for kind_now, interval in enumerate(_INTERVALS):
-            lo, hi = first_pair[kind_now], first_pair[kind_now + 1]
-            if lo == hi:
-                continue
-            s = shape_of[lo:hi]
-            near, far = interval([c[lo:hi] for c in o], [c[lo:hi] for c in d],
-                                 [size_t[0][s], size_t[1][s], size_t[2][s]])
-            hit = (near <= far) & (near >= range_min) & (near <= range_max)
-            np.minimum.at(result, ray_of[lo:hi][hit], near[hit])
-        return result
-
-
-_SIGNS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float).T
-
-
-def _support(shapes, normal):
-    """Half-width [m] of each shape along the unit vector `normal`."""
-    local = np.abs(normal @ shapes.rotation)                      # |normal| in shape frames
-    r, h = shapes.size[:, 0], shapes.size[:, 1]
-    axial = local[:, 2]
-    kind = shapes.kind
-    round_ = np.where(kind == _CYLINDER, r * np.sqrt(np.maximum(0.0, 1.0 - axial * axial)),
-                      r) + np.where(kind == _SPHERE, 0.0, h * axial)
-    return np.where(kind == _BOX, (local * shapes.size) @ _ONES, round_)
-
-
-def _sphere_pairs(directions, relative, distance, bound, range_min, range_max):
-    """(shape, ray) pairs whose ray meets the shape's bounding sphere, sorted by shape."""
-    along = relative @ directions.T                              # (k, n)
-    mask = distance[:, None] ** 2 - along ** 2 <= ((bound + 1e-9) ** 2)[:, None]
-    mask &= along >= range_min - bound[:, None]
-    mask &= along <= range_max + bound[:, None]
-    return np.nonzero(mask)
-
-
-def _fan_pairs(directions, normal, kind, relative, rotation, size):
-    """(shape, ray) pairs, sorted by shape, for rays that all lie in the plane through the
-    origin with unit `normal`: each shape's projection on that plane spans an angle seen from
-    the origin, and only the rays inside that angle are paired with it."""
-    u = directions[0]
-    v = np.array(cross(normal, u))
-    ray_angle = np.arctan2(directions @ v, directions @ u)
-    order = np.argsort(ray_angle, kind="stable")
-    sorted_angle = ray_angle[order]
-    n_shapes = len(kind)
-    centre_u, centre_v = relative @ u, relative @ v
-
-    low, high = np.empty(n_shapes), np.empty(n_shapes)
-    full = np.zeros(n_shapes, dtype=bool)
-    box = kind == _BOX
-    if np.any(box):
-        # a box's projection lies in the hull of its projected corners
-        half = size[box]
-        corner_u = centre_u[box, None] + ((u @ rotation[box]) * half) @ _SIGNS     # (b, 8)
-        corner_v = centre_v[box, None] + ((v @ rotation[box]) * half) @ _SIGNS
-        centre = np.arctan2(corner_v @ _EIGHTHS, corner_u @ _EIGHTHS)
-        offset = np.mod(np.arctan2(corner_v, corner_u) - centre[:, None] + np.pi,
-                        2 * np.pi) - np.pi
-        low[box] = centre + offset.min(axis=1)
-        high[box] = centre + offset.max(axis=1)
-        full[box] = ((high[box] - low[box] >= np.pi - 1e-9)
-                     | (np.hypot(corner_u, corner_v).min(axis=1) < 1e-9))
-    round_ = ~box
-    if np.any(round_):
-        # spheres: radius r; cylinders, capsules: their axis segment projected, widened by r
-        axial = np.abs(normal @ rotation[round_, :, 2].T)          # |cos| of axis to normal
-        r, h = size[round_, 0], size[round_, 1]
-        radius = np.where(kind[round_] == _SPHERE, r,
-                          r + h * np.sqrt(np.maximum(0.0, 1.0 - axial * axial)))
-        reach = np.hypot(centre_u[round_], centre_v[round_])
-        centre = np.arctan2(centre_v[round_], centre_u[round_])
-        half_angle = np.arcsin(np.minimum(1.0, radius / np.maximum(reach, 1e-300)))
-        low[round_], high[round_] = centre - half_angle, centre + half_angle
-        full[round_] = reach <= radius * (1 + 1e-12)
-    low[full], high[full] = -np.pi, np.pi
-
-    # angle intervals -> index ranges of the sorted rays (an interval may wrap past +-pi)
-    pad = 1e-9                                                    # [rad]
-    shift = np.where(low < -np.pi, 2 * np.pi, 0.0)
-    low, high = low + shift - pad, high + shift + pad
-    start = np.searchsorted(sorted_angle, low, "left")
-    stop = np.searchsorted(sorted_angle, high, "right")
-    stop_wrapped = np.where(high > np.pi,
-                            np.searchsorted(sorted_angle, high - 2 * np.pi, "right"), 0)
-    stop_wrapped = np.where(full, 0, np.minimum(stop_wrapped, start))
-    # segments [start, stop) and [0, stop_wrapped) of each shape, in shape order
-    shape = np.repeat(np.arange(n_shapes), 2)
-    start = np.column_stack([start, np.zeros_like(start)]).ravel()
-    length = np.maximum(0, np.column_stack([stop, stop_wrapped]).ravel() - start)
-    total = int(length.sum())
-    segment = np.repeat(np.arange(len(length)), length)
-    within = np.arange(total) - np.repeat(np.cumsum(length) - length, length)
-    return shape[segment], order[start[segment] + within]
-
-
-_EIGHTHS = np.full(8, 1.0 / 8.0)
-
-
-# --- exact entry/exit parameters of rays, per pair: origin o and unit direction d in the
-# shape's frame and the shape's size, each as three component arrays. Divisions by zero
-# (rays parallel to a face or axis) give the infinities the tests expect: callers run them
-# under np.errstate(divide="ignore", invalid="ignore"). --------------------------------------
-def _slab(o, d, half):
-    """Entry and exit of the slab |x| <= half along one axis; (-inf, inf) when parallel inside,
-    empty when parallel outside."""
-    inverse = 1.0 / d
-    t1 = (-half - o) * inverse
-    t2 = (half - o) * inverse
-    return np.fmin(t1, t2), np.fmax(t1, t2)
-
-
-def _box_interval(o, d, size):
-    nx, fx = _slab(o[0], d[0], size[0])
-    ny, fy = _slab(o[1], d[1], size[1])
-    nz, fz = _slab(o[2], d[2], size[2])
-    return np.maximum(np.maximum(nx, ny), nz), np.minimum(np.minimum(fx, fy), fz)
-
-
-def _quadratic_interval(a, half_b, c):
-    """Roots of a t^2 + 2 half_b t + c = 0 as (near, far); empty when none."""
-    disc = half_b * half_b - a * c
-    root = np.sqrt(np.maximum(disc, 0.0))
-    q = -(half_b + np.copysign(root, half_b))
-    t1 = q / a
-    t2 = c / q
-    near, far = np.fmin(t1, t2), np.fmax(t1, t2)
-    miss = disc < 0.0
-    return np.where(miss, np.inf, near), np.where(miss, -np.inf, far)
-
-
-def _sphere_interval(o, d, size):
-    half_b = o[0] * d[0] + o[1] * d[1] + o[2] * d[2]
-    c = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - size[0] * size[0]
-    return _quadratic_interval(1.0, half_b, c)
-
-
-def _cylinder_interval(o, d, size):
-    """Cylinder about the local z axis, radius size[0], half length size[1]."""
-    a = d[0] * d[0] + d[1] * d[1]
-    half_b = o[0] * d[0] + o[1] * d[1]
-    c = o[0] * o[0] + o[1] * o[1] - size[0] * size[0]
-    near, far = _quadratic_interval(a, half_b, c)
-    parallel = a < _PARALLEL
-    if np.any(parallel):
-        inside = c <= 0.0
-        near = np.where(parallel, np.where(inside, -np.inf, np.inf), near)
-        far = np.where(parallel, np.where(inside, np.inf, -np.inf), far)
-    z_near, z_far = _slab(o[2], d[2], size[1])
-    return np.maximum(near, z_near), np.minimum(far, z_far)
-
-
-def _capsule_interval(o, d, size):
-    """A capsule is convex: its interval is the union of its cylinder's and end spheres'."""
-    near, far = _cylinder_interval(o, d, size)
-    for sign in (1.0, -1.0):
-        end = (o[0], o[1], o[2] - sign * size[1])
-        near, far = _union(near, far, *_sphere_interval(end, d, size))
-    return near, far
-
-
-def _union(n1, f1, n2, f2):
-    """Union of two intervals that overlap when both are non-empty (parts of a convex shape)."""
-    empty1, empty2 = n1 > f1, n2 > f2
-    near = np.where(empty1, n2, np.where(empty2, n1, np.minimum(n1, n2)))
-    far = np.where(empty1, f2, np.where(empty2, f1, np.maximum(f1, f2)))
-    return near, far
-
-
-_INTERVALS = (_sphere_interval, _box_interval, _cylinder_interval, _capsule_interval)
+_NO_PLANE = np.zeros(3)            # the kernel's "no common plane"
