@@ -40,12 +40,13 @@ def test_sigint_ends_a_well_behaved_child(tmp_path, run_env):
     uri, env = run_env
     child = Child("sleeper", ["sleep", "30"], env, str(tmp_path / "sleeper.log"))
     assert child.running()
-    assert processes.leftovers(uri) == [child.pid]
-    # A SIGINT that lands between fork and exec is swallowed by the forked Python's handler;
-    # a real child has long exec'd when the demo stops it, so wait for that here too.
+    # Between fork and exec the child still has this process's environment (so leftovers
+    # cannot know it yet), and a SIGINT then is swallowed by the forked Python's handler; a
+    # real child has long exec'd when the demo looks for it or stops it, so wait for that.
     deadline = time.monotonic() + 5.0
     while time.monotonic() < deadline and not exec_done(child.pid, b"sleep"):
         time.sleep(0.01)
+    assert processes.leftovers(uri) == [child.pid]
     outcome = processes.stop([child], sigint_timeout=5.0, sigterm_timeout=1.0)
     assert outcome == {"sleeper": "exit -2"}
     assert processes.leftovers(uri) == []
