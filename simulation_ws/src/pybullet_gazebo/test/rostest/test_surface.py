@@ -101,6 +101,10 @@ class SurfaceTest(unittest.TestCase):
         cls.master = rosgraph.Master("/test_surface")
         cls.node = xmlrpc.client.ServerProxy(cls.master.lookupNode("/gazebo"))
 
+    def test_sets_the_rosout_topics_parameter_rospy_logging_needs_cached(self):
+        # unset, every rospy.loginfo of every node asks the master for it (ros_comm 2337)
+        self.assertIs(rospy.get_param("/rosout_disable_topics_generation"), False)
+
     def test_documented_services_are_the_ones_listed_here(self):
         doc = simulator_node.__doc__
         services = doc[doc.index("services are Gazebo's:"):doc.index("Topics out:")]
