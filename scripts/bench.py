@@ -8,7 +8,9 @@ Figures:
   whole loop        real-time factor of simulator + obstacle_avoidance.py, headless, with
                     real_time_factor 0: free-running (lockstep false) and in lockstep, at the
                     demo's /clock rate and at the simulator's default 100 Hz; CPU time of
-                    the simulator and of the controller per sim second
+                    the simulator and of the controller per sim second; how often the robot
+                    touched a model (free-running, the controller's answers come late in sim
+                    time and the robot hits barriers: the reason lockstep exists)
   lockstep check    scans published vs cmd_vel answers over a window that starts and ends
                     paused (so no answer is in flight at either edge)
   physics alone     the engine only (no ROS), world02 + m2wr: Bullet's stepSimulation, and
@@ -112,20 +114,30 @@ def engine_figures(steps=2000, scans=300):
 
 # --- the ROS loop --------------------------------------------------------------------------
 class Listener:
-    """The bench's ears: /clock always; scans (with stamps) and cmd_vel while counting."""
+    """The bench's ears: /clock and the robot's touches always; scans (with stamps) and
+    cmd_vel while counting."""
 
     def __init__(self):
         import rospy
+        from gazebo_msgs.msg import ContactsState
         from rosgraph_msgs.msg import Clock
         self.sim_time = None
+        self.touches = 0                    # times the robot started touching a model
         self.first_scan_wall = None
         self._scan_event = threading.Event()
         self._subs = []
         self.scan_stamps, self.answers, self.callbacks = [], 0, 0
         rospy.Subscriber("/clock", Clock, self._on_clock, queue_size=1)
+        self._touching = set()
+        rospy.Subscriber("/gazebo/contacts", ContactsState, self._on_contacts, queue_size=1000)
 
     def _on_clock(self, msg):
         self.sim_time = msg.clock.to_sec()
+
+    def _on_contacts(self, msg):
+        touching = {(s.collision1_name, s.collision2_name) for s in msg.states}
+        self.touches += len(touching - self._touching)
+        self._touching = touching
 
     def count(self, scans=True, commands=True):
         import rospy
@@ -221,10 +233,10 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         call_empty("/gazebo/unpause_physics")
         time.sleep(warmup)
         session.check_running(["world", "controller"])
-        sim0, wall0 = listener.wait_sim(), time.monotonic()
+        sim0, wall0, touches0 = listener.wait_sim(), time.monotonic(), listener.touches
         cpu0 = (processes.cpu_seconds(sim_pid), processes.cpu_seconds(ctrl_pid))
         time.sleep(seconds)
-        sim1, wall1 = listener.wait_sim(), time.monotonic()
+        sim1, wall1, touches1 = listener.wait_sim(), time.monotonic(), listener.touches
         cpu1 = (processes.cpu_seconds(sim_pid), processes.cpu_seconds(ctrl_pid))
         session.check_running(["world", "controller"])
         sim_s, wall_s = sim1 - sim0, wall1 - wall0
@@ -251,6 +263,7 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
     result = {
         "lockstep": lockstep, "pub_clock_frequency_hz": clock_hz,
         "x_real_time": benchmath.rate(sim_s, wall_s), "sim_s": sim_s, "wall_s": wall_s,
+        "robot_touches": touches1 - touches0,
         "cpu_ms_per_sim_s": {
             "simulator": 1e3 * (cpu1[0] - cpu0[0]) / sim_s if sim_s > 0 else None,
             "controller": 1e3 * (cpu1[1] - cpu0[1]) / sim_s if sim_s > 0 else None},
@@ -295,6 +308,7 @@ def launch_to_first_scan(session, listener, clock_hz, timeout=60.0):
 
 def soak(session, listener, minutes, clock_hz):
     say("soak: lockstep loop for %g min of wall time" % minutes)
+    started = time.time()
     sim_pid, _ = start_loop(session, True, clock_hz)
     try:
         listener.count(scans=True, commands=True)
@@ -319,7 +333,7 @@ def soak(session, listener, minutes, clock_hz):
         answers, handled = after[1] - before[1], after[2] - before[2]
     finally:
         stop_loop(session)
-    errors = error_lines(session.log_dir)
+    errors = error_lines(session.log_dir, since=started)
     result = {
         "minutes": minutes, "sim_s": sim1 - sim0, "x_real_time": benchmath.rate(sim1 - sim0, wall1 - wall0),
         "scans": len(stamps), "handled_by_controller": handled, "cmd_vel_answers": answers,
@@ -340,14 +354,15 @@ def soak(session, listener, minutes, clock_hz):
 _ERROR = re.compile(r"\[ERROR\]|\bERROR\b|Traceback")
 
 
-def error_lines(folder):
-    """'file: line' for each ERROR (or Traceback) line in the logs under folder."""
+def error_lines(folder, since=0.0):
+    """'file: line' for each ERROR (or Traceback) line in the logs under folder written to
+    at or after `since` (time.time()); earlier runs' logs stay in the folder."""
     found = []
     for base, _, files in os.walk(folder):
         for name in sorted(files):
-            if not name.endswith(".log"):
-                continue
             path = os.path.join(base, name)
+            if not name.endswith(".log") or os.path.getmtime(path) < since:
+                continue
             with open(path, errors="replace") as log:
                 for line in log:
                     if _ERROR.search(line):
@@ -365,6 +380,7 @@ def report(figures):
                                            for n in names]),
         ("  controller CPU per sim s [ms]", [fmt(loops[n]["cpu_ms_per_sim_s"]["controller"], "%.0f")
                                             for n in names]),
+        ("robot touched a model (times)", [str(loops[n]["robot_touches"]) for n in names]),
         ("scans published in the check window", [str(loops[n]["check"]["scans_published"])
                                                  for n in names]),
         ("  handled by the controller", [str(loops[n]["check"]["handled_by_controller"])

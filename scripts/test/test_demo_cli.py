@@ -1,4 +1,6 @@
 """The command lines of scripts/demo.py and scripts/bench.py, and the session's error text."""
+import os
+
 import pytest
 
 import bench
@@ -69,3 +71,15 @@ def test_bench_finds_error_lines(tmp_path):
     found = sorted(bench.error_lines(str(tmp_path)))
     assert found == ["ros/node.log: Traceback (most recent call last):",
                      "world.log: [ERROR] [1.0]: bad thing"]
+
+
+def test_bench_error_lines_skip_logs_of_earlier_runs(tmp_path):
+    old = tmp_path / "ros" / "run1" / "master.log"
+    old.parent.mkdir(parents=True)
+    old.write_text("[ERROR] from an earlier run\n")
+    os.utime(old, (1000.0, 1000.0))
+    new = tmp_path / "ros" / "run2" / "master.log"
+    new.parent.mkdir(parents=True)
+    new.write_text("[ERROR] from this run\n")
+    assert bench.error_lines(str(tmp_path), since=2000.0) == [
+        "ros/run2/master.log: [ERROR] from this run"]
