@@ -115,8 +115,10 @@ class SimulatorNode:
             if self.params.debug:          # a per-message hot path: no work when not asked
                 rospy.logdebug_throttle(1.0, "%s for '%s': linear.x %.3f, angular.z %.3f"
                                         % (drive.command_topic, name, msg.linear.x, msg.angular.z))
-            with self.lock:
-                drive.set_command(msg.linear.x, msg.angular.z)
+            # Not under self.lock: the loop holds it while it steps, and waiting for it here
+            # delayed commands by whole steps when running free. Setting the command is one
+            # attribute write, read by the drive at its next update.
+            drive.set_command(msg.linear.x, msg.angular.z)
         with self.command_arrived:
             self.commands_received += 1
             self.command_arrived.notify_all()
