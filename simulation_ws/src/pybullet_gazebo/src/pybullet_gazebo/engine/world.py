@@ -5,10 +5,10 @@ services need (model states, reset, delete, contacts).
 Frames: a model's pose is its model frame in the world, as Gazebo reports it. A world model
 becomes one Bullet body per link: a rigid body in maximal coordinates (world02 steps 15 %
 faster than with multibodies), or a multibody when it holds a plane (pybullet cannot report a
-maximal body's shapes, and the ground checks read the plane back). A robot is one Bullet multibody loaded from its URDF,
-whose model frame is its root link's frame. Bullet reports a body's inertial (centre-of-mass)
-frame; `_link_frame` converts, with the offsets kept in the Entity (pybullet 3.2 reports
-garbage for a maximal body's inertial frame).
+maximal body's shapes, and the ground checks read the plane back). A robot is one Bullet
+multibody loaded from its URDF, whose model frame is its root link's frame. Bullet reports a
+body's inertial (centre-of-mass) frame; `_link_frame` converts, with the offsets kept in the
+Entity (pybullet 3.2 reports garbage for a maximal body's inertial frame).
 """
 from dataclasses import dataclass, field
 import math
@@ -488,19 +488,16 @@ class World:
 
     @staticmethod
     def _append_shape(kwargs, collision):
-        geometry = collision.geometry
+        kind, dimensions = _bullet_geometry(collision)
         radius, half, length, normal = 0.0, [0.0, 0.0, 0.0], 0.0, [0.0, 0.0, 1.0]
-        if isinstance(geometry, Box):
-            kind, half = pybullet.GEOM_BOX, [s / 2.0 for s in geometry.size]
-        elif isinstance(geometry, Cylinder):
-            kind, radius, length = pybullet.GEOM_CYLINDER, geometry.radius, geometry.length
-        elif isinstance(geometry, Sphere):
-            kind, radius = pybullet.GEOM_SPHERE, geometry.radius
-        elif isinstance(geometry, Plane):
-            kind, normal = pybullet.GEOM_PLANE, list(geometry.normal)
+        if kind == pybullet.GEOM_BOX:
+            half = [s / 2.0 for s in dimensions]
+        elif kind == pybullet.GEOM_CYLINDER:
+            length, radius = dimensions[0], dimensions[1]
+        elif kind == pybullet.GEOM_SPHERE:
+            radius = dimensions[0]
         else:
-            raise ValueError("collision '%s': geometry %r is not supported"
-                             % (collision.name, geometry))
+            normal = list(dimensions)
         kwargs["shapeTypes"].append(kind)
         kwargs["radii"].append(radius)
         kwargs["halfExtents"].append(half)
@@ -527,6 +524,15 @@ def _shape_data(collision, inertial_pose):
     """A collision as pybullet's getCollisionShapeData reports one: (geometry type,
     dimensions, position, orientation), the pose in the link's inertial frame. The caster
     needs it for the bodies whose shapes pybullet cannot report."""
+    kind, dimensions = _bullet_geometry(collision)
+    local = inertial_pose.inverse().compose(collision.pose)
+    return kind, dimensions, local.position, local.orientation
+
+
+def _bullet_geometry(collision):
+    """(Bullet geometry type, dimensions as getCollisionShapeData gives them: box full
+    extents, cylinder (length, radius, 0), sphere (r, r, r), plane normal) of a collision;
+    ValueError for a geometry the stand-in cannot simulate."""
     geometry = collision.geometry
     if isinstance(geometry, Box):
         kind, dimensions = pybullet.GEOM_BOX, tuple(geometry.size)
@@ -539,5 +545,4 @@ def _shape_data(collision, inertial_pose):
     else:
         raise ValueError("collision '%s': geometry %r is not supported"
                          % (collision.name, geometry))
-    local = inertial_pose.inverse().compose(collision.pose)
-    return kind, dimensions, local.position, local.orientation
+    return kind, dimensions

@@ -194,7 +194,8 @@ class SimulatorNode:
                 scans += 1
             else:
                 odometry_heard = publisher.get_num_connections() > 0
-                tf_heard = reading.component.publish_odom_tf and self.tf_pub.get_num_connections() > 0
+                tf_heard = (reading.component.publish_odom_tf
+                            and self.tf_pub.get_num_connections() > 0)
                 if not (odometry_heard or tf_heard):
                     continue
                 odometry, transform = conversions.odometry_to_msgs(
