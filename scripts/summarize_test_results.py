@@ -4,6 +4,8 @@ line per failed test case and a closing line `N passed, N failed, N skipped`.
 
 Exit status 1 when anything failed or errored, or when no test ran at all. A rostest that
 crashed before writing results shows up here as catkin's "MISSING-RESULT" failure file.
+rostest's own verdict per suite (`* RESULT: FAIL` in the `*-run_tests.log` files) is read
+too: a failing suite whose result file another suite overwrote still counts as failed.
 """
 import sys
 import xml.etree.ElementTree as ET
@@ -20,6 +22,18 @@ def count(results_dir):
             failed += 1
             failures.append("%s: unreadable result file (%s)" % (path, err))
             continue
+        # a suite that errored before any case ran (setUpClass, a missing package) has
+        # errors= on the suite and no failing case: count it
+        suites = [root] if root.tag == "testsuite" else list(root.iter("testsuite"))
+        for suite in suites:
+            cases = suite.findall("testcase")
+            broken = sum(1 for c in cases if c.find("failure") is not None
+                         or c.find("error") is not None)
+            declared = int(suite.get("errors", 0) or 0) + int(suite.get("failures", 0) or 0)
+            if declared > broken:
+                failed += declared - broken
+                failures.append("%s: %d error(s) outside any test case (%s)"
+                                % (suite.get("name", ""), declared - broken, path.name))
         for case in root.iter("testcase"):
             name = "%s.%s" % (case.get("classname", ""), case.get("name", ""))
             if case.find("failure") is not None or case.find("error") is not None:
@@ -32,9 +46,27 @@ def count(results_dir):
     return passed, failed, skipped, failures
 
 
+def failed_suites(results_dir):
+    """(suite, ...) whose rostest run ended `RESULT: FAIL`, from the run_tests logs."""
+    suites = []
+    for log in sorted(Path(results_dir).glob("*-run_tests.log")):
+        suite = None
+        for line in log.read_text(errors="replace").splitlines():
+            if "/usr/bin/rostest " in line:
+                suite = line.split()[-1]
+            elif "RESULT: FAIL" in line and suite is not None:
+                suites.append(suite)
+    return suites
+
+
 def main():
     results_dir = sys.argv[1] if len(sys.argv) > 1 else "test_results"
     passed, failed, skipped, failures = count(results_dir)
+    unseen = [s for s in failed_suites(results_dir)
+              if not any(Path(s).stem in f for f in failures)]
+    for suite in unseen:
+        failed += 1
+        failures.append("%s: rostest reported failure (see its run_tests log)" % suite)
     for line in failures:
         print("FAILED: " + line)
     print("%d passed, %d failed, %d skipped" % (passed, failed, skipped))
