@@ -83,7 +83,7 @@ def engine_figures(steps=2000, scans=300):
                                                                  0, 0, START[2]))
         for _ in range(200):            # lands on its wheels
             world.step()
-        for component in robot.components:
+        for component in robot.parts:
             if hasattr(component, "set_command"):
                 component.set_command(0.0, 0.3)      # turning on the spot: wheels in contact
         t = time.perf_counter()
@@ -94,7 +94,7 @@ def engine_figures(steps=2000, scans=300):
         for _ in range(steps):
             world.step()
         engine = time.perf_counter() - t
-        sensor = next(c for c in robot.components if isinstance(c, RaySensor))
+        sensor = next(c for c in robot.parts if isinstance(c, RaySensor))
         t = time.perf_counter()
         for _ in range(scans):
             sensor.measure(world.sim_time)

@@ -21,7 +21,8 @@ from pybullet_utils.bullet_client import BulletClient
 from pybullet_gazebo.engine.diff_drive import DiffDrive
 from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
 from pybullet_gazebo.engine.transforms import Pose
-from pybullet_gazebo.engine.world import MAX_COORDINATE, SpawnError, World
+from pybullet_gazebo.engine.placement import MAX_COORDINATE
+from pybullet_gazebo.engine.world import SpawnError, World
 
 SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 STEP = 0.005                        # [s]
@@ -195,7 +196,7 @@ def test_bad_model_state_is_refused_and_the_world_stays_finite(world, name, pose
 def test_huge_command_is_clamped_and_the_robot_stays_finite_and_out_of_obstacles(world,
                                                                                  command):
     robot = world.entities["m2wr"].robot
-    drive = next(c for c in robot.components if isinstance(c, DiffDrive))
+    drive = next(c for c in robot.parts if isinstance(c, DiffDrive))
     client = world.client
     wheels = [robot.joints["joint_left_wheel"], robot.joints["joint_right_wheel"]]
     assert drive.set_command(*command)

@@ -119,7 +119,7 @@ def test_m2wr_caster_friction_is_zero_and_goes_to_the_chassis(m2wr):
 
 
 def test_stripped_m2wr_loads_in_pybullet_with_its_joints_and_inertias(m2wr_urdf, tmp_path):
-    text = strip_for_bullet(m2wr_urdf)
+    text = strip_for_bullet(parse_robot(m2wr_urdf, "m2wr"))
     robot = ET.fromstring(text)
     assert robot.find("gazebo") is None
     assert robot.find("link/pose") is None

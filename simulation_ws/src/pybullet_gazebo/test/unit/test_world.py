@@ -49,7 +49,7 @@ def make_world():
 
 
 def component(robot, kind):
-    return next(c for c in robot.components if isinstance(c, kind))
+    return next(c for c in robot.parts if isinstance(c, kind))
 
 
 def run(world, seconds):
@@ -186,8 +186,8 @@ def test_scans_and_odometry_come_at_their_rates(make_world, m2wr_urdf):
     world = make_world("world02")
     world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(0, 8, 0.5))
     readings = run(world, 2.0)
-    scans = [r for r in readings if isinstance(r.component, RaySensor)]
-    odometry = [r for r in readings if isinstance(r.component, DiffDrive)]
+    scans = [r for r in readings if isinstance(r.part, RaySensor)]
+    odometry = [r for r in readings if isinstance(r.part, DiffDrive)]
     assert len(scans) == 40
     assert len(odometry) == 40
     assert len(scans[-1].data.ranges) == 720
@@ -202,7 +202,7 @@ def test_same_seed_and_commands_give_identical_runs(make_world, m2wr_urdf):
         for second in range(6):
             drive.set_command(0.6 if second % 2 == 0 else 0.0, 0.3 if second % 3 == 0 else 0.0)
             for reading in run(world, 1.0):
-                if isinstance(reading.component, RaySensor):
+                if isinstance(reading.part, RaySensor):
                     scans.append(reading.data.ranges.copy())
             poses.append(world.model_pose("m2wr"))
         return poses, np.array(scans)

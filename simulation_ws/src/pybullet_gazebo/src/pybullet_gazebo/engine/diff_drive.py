@@ -41,6 +41,8 @@ import math
 import numpy as np
 import pybullet
 
+from .parameters import ParameterReader
+from .part import Part, PartContext
 from .transforms import Pose, cross
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
@@ -75,10 +77,16 @@ class _Cadence:
         return True
 
 
-class DiffDrive:
+class DiffDrive(Part):
     """A differential drive on two joints of a body."""
 
     KEY = "libgazebo_ros_diff_drive.so"
+
+    @classmethod
+    def build(cls, context: PartContext, plugin):
+        return cls(context.client, context.body_id, context.joints, plugin, context.warn,
+                   command_timeout=context.command_timeout,
+                   legacy_mode_swaps=context.legacy_mode_swaps)
 
     def __init__(self, client, body_id, joints, plugin, warn, command_timeout=0.0,
                  legacy_mode_swaps=False):
@@ -89,37 +97,8 @@ class DiffDrive:
         self.name = plugin.name
         params = dict(plugin.params)
         where = "diff drive plugin '%s' (%s)" % (plugin.name, plugin.filename)
-
-        def text(tag, default):
-            value = params.get(tag)
-            return default if value is None else value.strip()
-
-        def number(tag, default, minimum=None, above=None):
-            raw = params.get(tag)
-            if raw is None:
-                return default
-            try:
-                value = float(raw)
-            except ValueError:
-                raise ValueError("%s: <%s> is '%s', not a number" % (where, tag, raw))
-            if not math.isfinite(value):
-                raise ValueError("%s: <%s> is '%s'; give a finite number" % (where, tag, raw))
-            if minimum is not None and value < minimum:
-                raise ValueError("%s: <%s> is %s; it must be >= %s" % (where, tag, raw, minimum))
-            if above is not None and value <= above:
-                raise ValueError("%s: <%s> is %s; it must be > %s" % (where, tag, raw, above))
-            return value
-
-        def boolean(tag, default):
-            raw = params.get(tag)
-            if raw is None:
-                return default
-            value = raw.strip().lower()
-            if value in ("true", "1"):
-                return True
-            if value in ("false", "0"):
-                return False
-            raise ValueError("%s: <%s> is '%s'; write true or false" % (where, tag, raw))
+        read = ParameterReader(params, where, label="<%s>")
+        text, number, boolean = read.text, read.number, read.boolean
 
         self.command_topic = text("commandTopic", "cmd_vel")
         self.odometry_topic = text("odometryTopic", "odom")
@@ -135,6 +114,10 @@ class DiffDrive:
         self.wheel_acceleration = number("wheelAcceleration", 0.0, minimum=0.0)     # [m/s^2]
         self.wheel_torque = number("wheelTorque", 5.0, minimum=0.0)                 # [N m]
         self.update_rate = number("updateRate", 100.0)                              # [Hz]
+        for tag in ("publishWheelTF", "publishWheelJointState"):
+            if boolean(tag, False):
+                self._warn_once("%s: <%s>true is not simulated by the stand-in; ignored"
+                                % (where, tag))
         for tag in ("wheelSeparation", "wheelDiameter"):
             if tag not in params:
                 self._warn_once("%s: <%s> missing; Noetic's default %s m is used"
@@ -194,7 +177,7 @@ class DiffDrive:
         self._fresh = True
         return True
 
-    def next_update_time(self):
+    def next_command_time(self):
         """Sim time [s] of the next update, at which a command is read; a command set before
         the step that starts at this time takes effect then."""
         if self._control.last is None:
@@ -282,6 +265,10 @@ class DiffDrive:
         period); always false when publishTf is false, as Noetic then publishes nothing."""
         return self.publish_tf and self._publish.take(sim_time)
 
+    def measure(self, now):
+        """The reading due at `now` [s]: the odometry."""
+        return self.odometry()
+
     def odometry(self):
         """Odometry of the base link now (see the module docstring)."""
         if self.odometry_source == "encoder":
@@ -299,6 +286,24 @@ class DiffDrive:
         angular = np.array(angular)
         to_base = link.matrix.T
         return Odometry(link, to_base @ linear, to_base @ angular)
+
+    def positive_turn_direction(self):
+        """'clockwise' or 'counter-clockwise': which way a positive angular.z turns the robot,
+        seen from above, given where the named joints really are. gazebo_ros_diff_drive gives
+        the joint *named* by rightJoint the faster wheel for a positive angular.z, whatever
+        side it is on; if it sits on the robot's left (+y), the robot turns clockwise."""
+        client = self._client
+        com = Pose(*client.getBasePositionAndOrientation(self.body_id))
+        root = com.compose(self._base_inertial.inverse())
+        lateral = {}
+        for index, name, _ in self._joints:
+            world_position = client.getLinkState(self.body_id, index,
+                                                 computeForwardKinematics=True)[4]
+            lateral[name] = root.inverse().transform_point(world_position)[1]
+        faster_on_left = lateral[self.right_joint] > lateral[self.left_joint]
+        if self.legacy_mode:
+            faster_on_left = not faster_on_left
+        return "clockwise" if faster_on_left else "counter-clockwise"
 
     def _warn_once(self, key, message=None):
         """Report `message` (default: the key itself) the first time `key` comes up."""

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .part import Part, PartContext
 from .transforms import Pose
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
@@ -39,10 +40,15 @@ class LaserScanData:
     ranges: np.ndarray          # float32 (samples,) [m]; +inf where nothing is in range
 
 
-class RaySensor:
+class RaySensor(Part):
     """A laser scanner on a link of a body."""
 
     KEY = "ray"
+
+    @classmethod
+    def build(cls, context: PartContext, spec):
+        return cls(context.client, context.body_id, context.links[spec.link], spec,
+                   context.caster, context.rng)
 
     def __init__(self, client, body_id, link_index, spec, caster, rng):
         self._check(spec)
@@ -51,7 +57,7 @@ class RaySensor:
         self.link_index = link_index
         self.spec = spec
         self._caster = caster
-        self.rng = rng                       # numpy Generator; the World may swap it on reset
+        self.rng = rng                       # numpy Generator; reseed() swaps it on reset
         params = spec.plugin.params if spec.plugin is not None else {}
         self.topic = params.get("topicName", "/world").strip()
         self.frame_id = params.get("frameName", spec.link).strip().lstrip("/")
@@ -87,6 +93,9 @@ class RaySensor:
     def reset(self):
         """After a simulation reset: the next call to due() is true."""
         self._last = None
+
+    def reseed(self, rng):
+        self.rng = rng
 
     def due(self, sim_time):
         """True when at least 1/update_rate [s] of sim time passed since the last scan (and on

@@ -1,21 +1,22 @@
-"""The stand-in's components, keyed by what they stand in for in a URDF's `<gazebo>` tags:
+"""The stand-in's robot parts, keyed by what they stand in for in a URDF's `<gazebo>` tags:
 a `<plugin filename=...>` or a `<sensor type=...>`. A key that is not here is reported by
-name at spawn (the World's job), never silently ignored.
+name at spawn (robot_loader's job), never silently ignored. The ROS adapter's bindings
+(ros/bindings.py) are keyed by the same KEYs.
 """
 from .diff_drive import DiffDrive
 from .ray_sensor import RaySensor
 
-# <gazebo><plugin filename="..."> -> component class
-PLUGINS = {
+# <gazebo><plugin filename="..."> -> Part class
+PLUGIN_PARTS = {
     DiffDrive.KEY: DiffDrive,
 }
 
-# <gazebo reference="link"><sensor type="..."> -> component class
-SENSORS = {
+# <gazebo reference="link"><sensor type="..."> -> Part class
+SENSOR_PARTS = {
     RaySensor.KEY: RaySensor,
 }
 
-# Plugins a sensor block carries that its sensor component already implements.
+# Plugins a sensor block carries that its sensor part already implements.
 SENSOR_PLUGINS = {
     "libgazebo_ros_laser.so": RaySensor.KEY,
 }

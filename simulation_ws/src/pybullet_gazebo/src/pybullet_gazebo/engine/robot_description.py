@@ -7,8 +7,11 @@ what Gazebo would take from it beyond links and joints, and cleans it for pybull
   `<surface><friction><ode><mu>/<mu2>` written inside URDF `<collision>` elements.
   Anything it does not simulate becomes a warning naming the tag (`RobotSpec.warnings`);
   a description it cannot use raises `RobotDescriptionError` saying what and where.
-- `strip_for_bullet(urdf_xml)` -> the same URDF with only URDF elements left (no `<gazebo>`
-  blocks, no link `<pose>`, no collision `<surface>`), for `loadURDF`.
+- `bullet_tree(spec)` -> a copy of the parsed URDF with only URDF elements left (no `<gazebo>`
+  blocks, no link `<pose>`, no collision `<surface>`), for `loadURDF`; `strip_for_bullet(spec)`
+  is the same as text.
+The text is parsed once, by parse_robot; everything else reads the RobotSpec it returns (its
+`urdf` element tree, links and joints).
 - `effective_link_friction(spec)` -> one (mu1, mu2) per link, by the rule below.
 
 Friction rule. Bullet holds one friction per link, while a URDF link may have several
@@ -28,6 +31,7 @@ default. Collision keys are (link name, collision name), or (link name, "N") for
 
 No pybullet here: plain XML (xml.etree) in, `specs` dataclasses and text out.
 """
+import copy
 import dataclasses
 import math
 import xml.etree.ElementTree as ET
@@ -119,21 +123,39 @@ def parse_robot(urdf_xml: str, model_name: str) -> RobotSpec:
     return RobotSpec(name=model_name, root_link=root_link, plugins=tuple(plugins),
                      sensors=tuple(sensors), link_friction=link_friction,
                      collision_friction=_collision_friction(root),
-                     warnings=tuple(warnings))
+                     warnings=tuple(warnings), links=tuple(links), joints=joints, urdf=root)
 
 
-def strip_for_bullet(urdf_xml: str) -> str:
-    """The URDF with only URDF elements kept (see _URDF_CHILDREN): `<gazebo>` blocks, a
-    link's `<pose>`, a collision's `<surface>` and any other foreign element are removed;
-    comments go too. Raises RobotDescriptionError as parse_robot does for bad text."""
-    root = _parse_xml(urdf_xml)
+def bullet_tree(spec: RobotSpec) -> ET.Element:
+    """A copy of the robot's URDF tree with only URDF elements kept (see _URDF_CHILDREN):
+    `<gazebo>` blocks, a link's `<pose>`, a collision's `<surface>` and any other foreign
+    element are removed; comments go too. The spec's own tree is left as it is."""
+    root = copy.deepcopy(spec.urdf)
     _strip(root)
-    for element in root.iter():         # re-indent what the removals left ragged
+    return root
+
+
+def urdf_text(root: ET.Element) -> str:
+    """A URDF element tree as indented text, for pybullet's loader (which reads files)."""
+    for element in root.iter():         # re-indent what removals left ragged
         if element.text is not None and not element.text.strip():
             element.text = None
         element.tail = None
     ET.indent(root, "  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def strip_for_bullet(spec: RobotSpec) -> str:
+    """bullet_tree(spec) as text."""
+    return urdf_text(bullet_tree(spec))
+
+
+def driven_wheel_links(spec: RobotSpec, plugin_keys) -> set:
+    """Child links of the joints named by `leftJoint`/`rightJoint` of the robot's plugins
+    whose filename is in `plugin_keys` (its drives)."""
+    joint_names = {value for plugin in spec.plugins if plugin.filename in plugin_keys
+                   for key, value in plugin.params.items() if key in ("leftJoint", "rightJoint")}
+    return {spec.joints[name][1] for name in joint_names if name in spec.joints}
 
 
 def effective_link_friction(spec: RobotSpec) -> Dict[str, Tuple[float, float]]:

@@ -4,6 +4,7 @@ into Bullet bodies and components by `world.World`.
 """
 from dataclasses import dataclass, field
 from typing import Dict, Optional, Tuple
+import xml.etree.ElementTree as ET
 
 from .transforms import Pose
 
@@ -125,3 +126,6 @@ class RobotSpec:
     link_friction: Dict[str, Tuple[float, float]] = field(default_factory=dict)  # link: (mu1, mu2)
     collision_friction: Dict[Tuple[str, str], Tuple[float, float]] = field(default_factory=dict)
     warnings: Tuple[str, ...] = ()
+    links: Tuple[str, ...] = ()               # link names, in file order
+    joints: Dict[str, Tuple[str, str]] = field(default_factory=dict)   # name: (parent, child)
+    urdf: Optional[ET.Element] = field(default=None, compare=False, repr=False)  # parsed text

@@ -25,8 +25,13 @@ def rpy_from_quaternion(q):
     x, y, z, w = q
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-    return roll, pitch, yaw
+    return roll, pitch, yaw_from_quaternion(q)
+
+
+def yaw_from_quaternion(q):
+    """Yaw [rad] (heading about z) of a unit quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 def rotation_matrix(q):

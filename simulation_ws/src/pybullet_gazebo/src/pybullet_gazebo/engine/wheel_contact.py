@@ -28,10 +28,9 @@ CONTACT_MASS = 1e-3            # [kg] negligible next to the wheel's
 SPINNING_FRICTION = 0.001      # [m] Bullet's spinning-friction lever
 
 
-def add_contact_links(urdf_text, wheel_links):
-    """URDF text with a ground-contact sphere link fixed to each named wheel link whose
-    collision is a cylinder; returns (text, {wheel link: contact link})."""
-    root = ET.fromstring(urdf_text)
+def add_contact_links(root, wheel_links):
+    """Adds to a URDF element tree (changed in place) a ground-contact sphere link fixed to
+    each named wheel link whose collision is a cylinder; returns {wheel link: contact link}."""
     added = {}
     for link in root.findall("link"):
         name = link.get("name")
@@ -56,7 +55,7 @@ def add_contact_links(urdf_text, wheel_links):
         ET.SubElement(joint, "parent", link=name)
         ET.SubElement(joint, "child", link=contact)
         added[name] = contact
-    return ET.tostring(root, encoding="unicode"), added
+    return added
 
 
 def apply_groups(client, body, links, contacts):

@@ -2,7 +2,15 @@
 
 A request the world cannot honour answers `success: false` with a reason; no request, however
 malformed, stops the simulator (every handler catches and reports).
+
+The services see the simulator only through the narrow `Simulation` interface below (the
+simulator node implements it): the world to query under its lock, and the few operations
+that change more than the world (spawning and deleting bind or unbind a robot's topics;
+pausing and resetting restart the pacing).
 """
+import threading
+from typing import Protocol
+
 import rospy
 from std_srvs.srv import Empty, EmptyResponse
 from gazebo_msgs.msg import ODEPhysics
@@ -15,13 +23,28 @@ from geometry_msgs.msg import Vector3
 
 from pybullet_gazebo.ros import conversions
 
+from pybullet_gazebo.engine.world import Robot, World
+
 WORLD_FRAMES = ("", "world", "map")
 
 
+class Simulation(Protocol):
+    world: World                # query it (and set states) under `lock`
+    lock: threading.RLock
+    paused: bool
+    gui: bool                   # a window is open
+    real_time_factor: float     # sim seconds per wall second; 0 = unlimited
+
+    def spawn_urdf(self, name, urdf_xml, pose, namespace="") -> Robot: ...
+    def delete_model(self, name) -> None: ...
+    def set_paused(self, paused) -> None: ...
+    def reset(self, simulation: bool) -> None: ...
+
+
 class GazeboServices:
-    def __init__(self, node):
-        self.node = node
-        self.world = node.world
+    def __init__(self, sim: Simulation):
+        self.sim = sim
+        self.world = sim.world
         self._services = [
             rospy.Service("~reset_simulation", Empty, self.reset_simulation),
             rospy.Service("~reset_world", Empty, self.reset_world),
@@ -39,25 +62,21 @@ class GazeboServices:
 
     # --- std_srvs/Empty -----------------------------------------------------------------------
     def reset_simulation(self, _req):
-        with self.node.lock:
-            self.world.reset_simulation()
-            self.node.after_reset()
+        self.sim.reset(simulation=True)
         rospy.loginfo("reset_simulation: models back at their initial poses, sim time 0")
         return EmptyResponse()
 
     def reset_world(self, _req):
-        with self.node.lock:
-            self.world.reset_world()
-            self.node.after_reset()
+        self.sim.reset(simulation=False)
         rospy.loginfo("reset_world: models back at their initial poses")
         return EmptyResponse()
 
     def pause_physics(self, _req):
-        self.node.set_paused(True)
+        self.sim.set_paused(True)
         return EmptyResponse()
 
     def unpause_physics(self, _req):
-        self.node.set_paused(False)
+        self.sim.set_paused(False)
         return EmptyResponse()
 
     # --- models -------------------------------------------------------------------------------
@@ -67,10 +86,9 @@ class GazeboServices:
                                       "leave it empty (world)" % req.reference_frame)
         pose = conversions.pose_from_msg(req.initial_pose, zero_quaternion_is_identity=True)
         try:
-            with self.node.lock:
-                robot = self.world.spawn_urdf(req.model_name, req.model_xml, pose,
-                                              namespace=req.robot_namespace)
-                self.node.attach_robot(robot)
+            robot = self.sim.spawn_urdf(req.model_name, req.model_xml, pose,
+                                        namespace=req.robot_namespace)
+            with self.sim.lock:
                 turning = self.world.positive_turn_direction(robot)
         except Exception as err:                 # any bad input: report, keep running
             rospy.logerr("spawn_urdf_model '%s' failed: %s", req.model_name, err)
@@ -86,9 +104,7 @@ class GazeboServices:
 
     def delete_model(self, req):
         try:
-            with self.node.lock:
-                self.world.delete_model(req.model_name)
-                self.node.detach_robot(req.model_name)
+            self.sim.delete_model(req.model_name)
         except Exception as err:
             return DeleteModelResponse(False, "DeleteModel: %s" % err)
         return DeleteModelResponse(True, "DeleteModel: successfully deleted model")
@@ -96,7 +112,7 @@ class GazeboServices:
     def get_model_state(self, req):
         response = GetModelStateResponse()
         try:
-            with self.node.lock:
+            with self.sim.lock:
                 pose = self.world.model_pose(req.model_name)
                 linear, angular = self.world.model_twist(req.model_name)
                 if req.relative_entity_name not in WORLD_FRAMES:
@@ -124,7 +140,7 @@ class GazeboServices:
             pose = conversions.pose_from_msg(state.pose)
             linear = (state.twist.linear.x, state.twist.linear.y, state.twist.linear.z)
             angular = (state.twist.angular.x, state.twist.angular.y, state.twist.angular.z)
-            with self.node.lock:
+            with self.sim.lock:
                 if state.reference_frame not in WORLD_FRAMES:
                     reference = self.world.model_pose(state.reference_frame)
                     pose = reference.compose(pose)
@@ -138,14 +154,15 @@ class GazeboServices:
 
     # --- properties -----------------------------------------------------------------------------
     def get_world_properties(self, _req):
-        with self.node.lock:
+        with self.sim.lock:
             return GetWorldPropertiesResponse(self.world.sim_time, self.world.model_names(),
-                                              self.node.params.gui, True, "GetWorldProperties: got properties")
+                                              self.sim.gui, True,
+                                              "GetWorldProperties: got properties")
 
     def get_physics_properties(self, _req):
         gravity = self.world.spec.physics.gravity
-        rtf = self.node.real_time_factor
+        rtf = self.sim.real_time_factor
         return GetPhysicsPropertiesResponse(
-            self.world.step_size, self.node.paused,
+            self.world.step_size, self.sim.paused,
             rtf / self.world.step_size if rtf > 0 else 0.0, Vector3(*gravity), ODEPhysics(),
             True, "GetPhysicsProperties: got properties")

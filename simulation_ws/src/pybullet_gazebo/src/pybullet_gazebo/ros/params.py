@@ -4,6 +4,7 @@ The world comes from the command line (checked before any ROS traffic). Private
 parameters (~name), with units:
   paused              start with physics paused (Gazebo's `paused`)
   real_time_factor    sim seconds per wall second; 0 = as fast as the machine allows
+                      (unset: the world file's <real_time_factor>)
   max_step_size       [s] fixed physics step; 0 = the world file's <max_step_size>
   pub_clock_frequency [Hz] of sim time at which /clock is published
   model_states_rate   [Hz] of sim time at which /gazebo/model_states is published
@@ -14,23 +15,22 @@ parameters (~name), with units:
   gui                 open pybullet's GUI window (needs a display)
   debug               log at debug level
 Global: /use_sim_time (publish /clock).
+Each value is read with engine.parameters.ParameterReader: a bad one stops the node with a
+message naming the parameter, the value and the allowed range.
 """
 from dataclasses import dataclass
-import math
+from typing import Optional
 
-import rospy
+from pybullet_gazebo.engine.parameters import ROS_BOOLEANS, ParameterError, ParameterReader
 
-
-class ParameterError(ValueError):
-    pass
+__all__ = ["SimulatorParams", "ParameterError"]
 
 
 @dataclass(frozen=True)
 class SimulatorParams:
-    world_name: str                          # the resolved world file
     paused: bool = False
     use_sim_time: bool = True
-    real_time_factor: float = 1.0
+    real_time_factor: Optional[float] = None  # None: the world file's
     max_step_size: float = 0.005            # [s]
     pub_clock_frequency: float = 100.0      # [Hz]
     model_states_rate: float = 50.0         # [Hz]
@@ -41,45 +41,31 @@ class SimulatorParams:
     gui: bool = False
     debug: bool = False
 
-    def __post_init__(self):
-        def check(name, value, low, allow_zero=True):
-            if not (isinstance(value, (int, float)) and math.isfinite(value)) or value < low \
-                    or (not allow_zero and value == 0):
-                raise ParameterError("~%s = %r is invalid: expected a number >= %s%s"
-                                     % (name, value, low, "" if allow_zero else ", not 0"))
-        check("real_time_factor", self.real_time_factor, 0.0)
-        check("max_step_size", self.max_step_size, 0.0)
-        check("pub_clock_frequency", self.pub_clock_frequency, 0.0, allow_zero=False)
-        check("model_states_rate", self.model_states_rate, 0.0, allow_zero=False)
-        check("lockstep_timeout", self.lockstep_timeout, 0.0, allow_zero=False)
-        check("cmd_vel_timeout", self.cmd_vel_timeout, 0.0)
+    @staticmethod
+    def from_values(private, use_sim_time=True, where="gazebo"):
+        """Reads the node's private parameters from a dict (as rospy.get_param('~') gives
+        it); ParameterError names the first bad one."""
+        read = ParameterReader(private, where, label="~%s", booleans=ROS_BOOLEANS)
+        d = SimulatorParams()
+        return SimulatorParams(
+            paused=read.boolean("paused", d.paused),
+            use_sim_time=bool(use_sim_time),
+            real_time_factor=read.number("real_time_factor", d.real_time_factor, minimum=0.0),
+            max_step_size=read.number("max_step_size", d.max_step_size, minimum=0.0),
+            pub_clock_frequency=read.number("pub_clock_frequency", d.pub_clock_frequency,
+                                            above=0.0),
+            model_states_rate=read.number("model_states_rate", d.model_states_rate, above=0.0),
+            seed=read.integer("seed", d.seed, minimum=0),
+            lockstep=read.boolean("lockstep", d.lockstep),
+            lockstep_timeout=read.number("lockstep_timeout", d.lockstep_timeout, above=0.0),
+            cmd_vel_timeout=read.number("cmd_vel_timeout", d.cmd_vel_timeout, minimum=0.0),
+            gui=read.boolean("gui", d.gui),
+            debug=read.boolean("debug", d.debug),
+        )
 
     @staticmethod
-    def from_ros(world_name):
-        def get(name, default, kind):
-            value = rospy.get_param("~" + name, default)
-            if kind is bool and isinstance(value, str):
-                if value.lower() in ("true", "1", "yes"):
-                    return True
-                if value.lower() in ("false", "0", "no"):
-                    return False
-            try:
-                return kind(value)
-            except (TypeError, ValueError):
-                raise ParameterError("~%s = %r is not a %s" % (name, value, kind.__name__))
-        defaults = SimulatorParams(world_name="-")
-        return SimulatorParams(
-            world_name=world_name,
-            paused=get("paused", defaults.paused, bool),
-            use_sim_time=bool(rospy.get_param("/use_sim_time", True)),
-            real_time_factor=get("real_time_factor", defaults.real_time_factor, float),
-            max_step_size=get("max_step_size", defaults.max_step_size, float),
-            pub_clock_frequency=get("pub_clock_frequency", defaults.pub_clock_frequency, float),
-            model_states_rate=get("model_states_rate", defaults.model_states_rate, float),
-            seed=get("seed", defaults.seed, int),
-            lockstep=get("lockstep", defaults.lockstep, bool),
-            lockstep_timeout=get("lockstep_timeout", defaults.lockstep_timeout, float),
-            cmd_vel_timeout=get("cmd_vel_timeout", defaults.cmd_vel_timeout, float),
-            gui=get("gui", defaults.gui, bool),
-            debug=get("debug", defaults.debug, bool),
-        )
+    def from_ros():
+        import rospy
+        return SimulatorParams.from_values(rospy.get_param("~", {}),
+                                           rospy.get_param("/use_sim_time", True),
+                                           where=rospy.get_name())

@@ -1,6 +1,6 @@
 """The ROS face of the stand-in: runs a World and talks to ROS the way Gazebo does.
 
-Node name `gazebo`, so its services are Gazebo's:
+Node name `gazebo` (services: gazebo_services.py), so its services are Gazebo's:
   ~reset_simulation, ~reset_world, ~pause_physics, ~unpause_physics  (std_srvs/Empty)
   ~spawn_urdf_model (gazebo_msgs/SpawnModel), ~delete_model (gazebo_msgs/DeleteModel)
   ~spawn_sdf_model (gazebo_msgs/SpawnModel): always answers false (URDF only)
@@ -11,14 +11,13 @@ Topics out:
   ~model_states (gazebo_msgs/ModelStates) at ~model_states_rate [Hz sim]
   ~contacts (gazebo_msgs/ContactsState) the (robot, model) pairs touching, the ground excluded,
             each time that set changes (an empty list when the last touch ends)
-  per robot, from its <gazebo> tags: the laser's topicName (sensor_msgs/LaserScan) at the
-  sensor's update_rate, the diff drive's odometryTopic (nav_msgs/Odometry) and TF
-  odometryFrame -> robotBaseFrame at its updateRate.
+  per robot, what its parts' bindings publish (bindings.py): the laser's topicName
+  (sensor_msgs/LaserScan) at the sensor's update_rate, the diff drive's odometryTopic
+  (nav_msgs/Odometry) and TF odometryFrame -> robotBaseFrame at its updateRate.
 Topics in: per robot, the diff drive's commandTopic (geometry_msgs/Twist). Not /clock: the
 node is its source (see nodes/gazebo_world).
 Parameters: see params.py. All messages of one step carry that step's sim time; wall-clock
-pacing (real_time_factor, lockstep) lives here, never in the engine. Odometry and TF messages
-are built only while someone listens (the engine computes the odometry either way).
+pacing (real_time_factor, lockstep: pacing.py) lives in the adapter, never in the engine.
 """
 import os
 import threading
@@ -26,28 +25,29 @@ import time
 
 import pybullet
 import rospy
-from geometry_msgs.msg import Twist
 from gazebo_msgs.msg import ContactState, ContactsState, ModelStates
-from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 from pybullet_utils.bullet_client import BulletClient
 
-from pybullet_gazebo.engine.diff_drive import DiffDrive
-from pybullet_gazebo.engine.ray_sensor import RaySensor
 from pybullet_gazebo.engine.world import World
 from pybullet_gazebo.ros import conversions
+from pybullet_gazebo.ros.bindings import BindingContext, RobotBindings
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
+from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
 
 
 class SimulatorNode:
+    """Owns the World, the loop, /clock and the per-robot bindings; offers the Gazebo
+    services the narrow interface they use (the `Simulation` protocol of gazebo_services)."""
+
     def __init__(self, params, world_spec):
         self.params = params
         show_gui = params.gui and bool(os.environ.get("DISPLAY"))
         if params.gui and not show_gui:
             rospy.loginfo("gui requested but there is no display (DISPLAY is unset): running "
                           "headless; pass gui:=false to silence this")
+        self.gui = show_gui
         mode = pybullet.GUI if show_gui else pybullet.DIRECT
         self.client = BulletClient(connection_mode=mode)
         step = params.max_step_size or world_spec.physics.max_step_size
@@ -56,98 +56,95 @@ class SimulatorNode:
                            command_timeout=params.cmd_vel_timeout)
         self.lock = threading.RLock()             # guards the world: loop vs. service threads
         self.paused = params.paused
-        self.real_time_factor = params.real_time_factor
-        self.commands_received = 0
-        self.command_arrived = threading.Condition()
-        self._robot_io = {}                       # robot name -> (publishers, subscribers)
+        world_rtf = world_spec.physics.real_time_factor
+        self.real_time_factor = world_rtf if params.real_time_factor is None \
+            else params.real_time_factor
+        self.pacer = RealTimePacer(self.real_time_factor, self.world.sim_time)
+        self.lockstep = Lockstep(
+            params.lockstep, params.lockstep_timeout, is_shutdown=rospy.is_shutdown,
+            on_timeout=lambda: rospy.logwarn_throttle(
+                10.0, "lockstep: no cmd_vel within %.2f s of a scan; stepping on"
+                % params.lockstep_timeout))
+        self._bindings = {}                       # robot name -> RobotBindings
+        self._tf_publisher = None
+        self._binding_context = BindingContext(self._tf, self.lockstep.command_arrived,
+                                               debug=params.debug)
         self._last_touching = []
-        self._reset_pacing()
         # publication periods in whole physics steps, so they never drift
         self._clock_every = self._steps_per_period(params.pub_clock_frequency)
         self._last_clock_step = 0
-        self._awaited = None     # lockstep: (commands counted at a scan, sim time needed by)
         self._model_states_every = self._steps_per_period(params.model_states_rate)
 
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) \
             if params.use_sim_time else None
         self.model_states_pub = rospy.Publisher("~model_states", ModelStates, queue_size=1)
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100, latch=True)
-        self.tf_pub = rospy.Publisher("/tf", TFMessage, queue_size=100)
         self.services = GazeboServices(self)
         rospy.loginfo("world '%s' loaded from %s: %d models, physics step %.4f s, "
-                      "real_time_factor %s%s", world_spec.name, world_spec.source,
+                      "real_time_factor %s (%s)%s", world_spec.name, world_spec.source,
                       len(self.world.model_names()), step,
-                      self.real_time_factor or "unlimited", ", paused" if self.paused else "")
+                      self.real_time_factor or "unlimited",
+                      "the world file's" if params.real_time_factor is None else
+                      "~real_time_factor; the world file says %g" % world_rtf,
+                      ", paused" if self.paused else "")
 
     def _steps_per_period(self, rate):
         return max(1, int(round(1.0 / (rate * self.world.step_size))))
 
-    # --- robots' topics -------------------------------------------------------------------
-    def attach_robot(self, robot):
-        """Opens the topics a spawned robot's components publish and listen to."""
-        publishers, subscribers = {}, []
-        for component in robot.components:
-            if isinstance(component, RaySensor):
-                topic = rospy.names.ns_join(robot.namespace or "/", component.topic)
-                publishers[id(component)] = rospy.Publisher(topic, LaserScan, queue_size=1)
-            elif isinstance(component, DiffDrive):
-                ns = robot.namespace or "/"
-                publishers[id(component)] = rospy.Publisher(
-                    rospy.names.ns_join(ns, component.odometry_topic), Odometry, queue_size=1)
-                subscribers.append(rospy.Subscriber(
-                    rospy.names.ns_join(ns, component.command_topic), Twist,
-                    self._on_command, callback_args=(robot.name, component), queue_size=1))
-        self._robot_io[robot.name] = (publishers, subscribers)
+    def _tf(self):
+        if self._tf_publisher is None:
+            self._tf_publisher = rospy.Publisher("/tf", TFMessage, queue_size=100)
+        return self._tf_publisher
 
-    def detach_robot(self, name):
-        publishers, subscribers = self._robot_io.pop(name, ({}, []))
-        for subscriber in subscribers:
-            subscriber.unregister()
-        for publisher in publishers.values():
-            publisher.unregister()
+    # --- the Simulation interface the services use --------------------------------------
+    def spawn_urdf(self, name, urdf_xml, pose, namespace=""):
+        """Spawns a robot and opens its parts' topics; the world's SpawnError otherwise."""
+        with self.lock:
+            robot = self.world.spawn_urdf(name, urdf_xml, pose, namespace=namespace)
+            self._bindings[robot.name] = RobotBindings(robot, self._binding_context)
+        return robot
 
-    def _on_command(self, msg, args):
-        name, drive = args
-        if not conversions.is_finite_twist(msg):
-            rospy.logwarn_throttle(5.0, "ignored a %s command for '%s' with NaN or inf: %s"
-                                   % (drive.command_topic, name, [msg.linear.x, msg.angular.z]))
-        else:
-            if self.params.debug:          # a per-message hot path: no work when not asked
-                rospy.logdebug_throttle(1.0, "%s for '%s': linear.x %.3f, angular.z %.3f"
-                                        % (drive.command_topic, name, msg.linear.x, msg.angular.z))
-            # Not under self.lock: the loop holds it while it steps, and waiting for it here
-            # delayed commands by whole steps when running free. Setting the command is one
-            # attribute write, read by the drive at its next update.
-            drive.set_command(msg.linear.x, msg.angular.z)
-        with self.command_arrived:
-            self.commands_received += 1
-            self.command_arrived.notify_all()
+    def delete_model(self, name):
+        with self.lock:
+            self.world.delete_model(name)
+            bindings = self._bindings.pop(name, None)
+        if bindings is not None:
+            bindings.close()
+
+    def set_paused(self, paused):
+        self.paused = paused
+        self.pacer.restart(self.world.sim_time)
+
+    def reset(self, simulation):
+        """Gazebo's reset_simulation (`simulation` true: sim time back to 0) or reset_world."""
+        with self.lock:
+            if simulation:
+                self.world.reset_simulation()
+            else:
+                self.world.reset_world()
+            self.pacer.restart(self.world.sim_time)
+            self.lockstep.forget()
 
     # --- the loop -------------------------------------------------------------------------
-    def _reset_pacing(self):
-        self._pace_wall = time.monotonic()
-        self._pace_sim = self.world.sim_time
-
     def run(self):
         while not rospy.is_shutdown():
             if self.paused:
                 time.sleep(0.01)
                 continue
-            awaited = self._awaited
-            if awaited is not None and self.world.sim_time >= awaited[1]:
-                self._wait_for_command(awaited[0])
-                self._awaited = None
+            self.lockstep.wait_if_due(self.world.sim_time, self._commands_heard)
             with self.lock:
                 readings = self.world.step()
-                commands_before = self.commands_received
+                commands_before = self.lockstep.commands
                 now = self.world.sim_time
                 scans = self._publish(readings)
                 needed_at = self.world.next_command_time() if scans else None
-            if self.params.lockstep and needed_at is not None:
-                # The drive reads its command only at its next update (Gazebo's plugin does
-                # the same), so physics runs on until then while the controller thinks.
-                self._awaited = (commands_before, needed_at)
-            self._pace(now)
+            # The drive reads its command only at its next update (Gazebo's plugin does the
+            # same), so physics runs on until then while the controller thinks.
+            self.lockstep.expect_answer(commands_before, needed_at)
+            self.pacer.pace(now)
+
+    def _commands_heard(self):
+        return any(b.commands_heard() for b in list(self._bindings.values()))
 
     def _publish(self, readings):
         """Publishes what is due after a step, stamped with its sim time; returns the number
@@ -162,7 +159,11 @@ class SimulatorNode:
         stamp = conversions.stamp_of(self.world.step_count, self.world.step_size)
         if clock_due:
             self.clock_pub.publish(Clock(stamp))
-        scans = self._publish_readings(readings, stamp)
+        scans = 0
+        for reading in readings:
+            bindings = self._bindings.get(reading.robot.name)
+            if bindings is not None and bindings.publish(reading, stamp):
+                scans += 1
         if contacts_changed:
             self._last_touching = touching
             self._publish_contacts(touching, stamp)
@@ -182,30 +183,6 @@ class SimulatorNode:
             return True
         return False
 
-    def _publish_readings(self, readings, stamp):
-        scans = 0
-        for reading in readings:
-            publishers, _ = self._robot_io.get(reading.robot.name, ({}, []))
-            publisher = publishers.get(id(reading.component))
-            if publisher is None:
-                continue
-            if isinstance(reading.component, RaySensor):
-                publisher.publish(conversions.scan_to_msg(reading.data, stamp))
-                scans += 1
-            else:
-                odometry_heard = publisher.get_num_connections() > 0
-                tf_heard = (reading.component.publish_odom_tf
-                            and self.tf_pub.get_num_connections() > 0)
-                if not (odometry_heard or tf_heard):
-                    continue
-                odometry, transform = conversions.odometry_to_msgs(
-                    reading.data, reading.component, stamp)
-                if odometry_heard:
-                    publisher.publish(odometry)
-                if tf_heard:
-                    self.tf_pub.publish(TFMessage([transform]))
-        return scans
-
     def _publish_contacts(self, touching, stamp):
         msg = ContactsState()
         msg.header.stamp = stamp
@@ -222,40 +199,6 @@ class SimulatorNode:
             msg.pose.append(conversions.pose_to_msg(self.world.model_pose(name)))
             msg.twist.append(conversions.twist_to_msg(linear, angular))
         return msg
-
-    def _wait_for_command(self, commands_before):
-        """Lockstep: hold physics until a controller has answered the last scan (if one
-        listens), so the answer reaches the drive at the same sim time on every run."""
-        if not any(s.get_num_connections() for _, subs in self._robot_io.values() for s in subs):
-            return
-        deadline = time.monotonic() + self.params.lockstep_timeout
-        with self.command_arrived:
-            while self.commands_received == commands_before and not rospy.is_shutdown():
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    rospy.logwarn_throttle(10.0, "lockstep: no cmd_vel within %.2f s of a scan; "
-                                           "stepping on" % self.params.lockstep_timeout)
-                    return
-                self.command_arrived.wait(min(left, 0.1))
-
-    def _pace(self, now):
-        if self.real_time_factor <= 0:
-            return
-        target = self._pace_wall + (now - self._pace_sim) / self.real_time_factor
-        delay = target - time.monotonic()
-        if delay > 0:
-            time.sleep(delay)
-        elif delay < -0.5:          # far behind (a slow machine): do not try to catch up
-            self._reset_pacing()
-
-    # --- used by the services -------------------------------------------------------------
-    def set_paused(self, paused):
-        self.paused = paused
-        self._reset_pacing()
-
-    def after_reset(self):
-        self._reset_pacing()
-        self._awaited = None
 
     def shutdown(self):
         try:

@@ -8,6 +8,8 @@ import time
 import rospy
 from gazebo_msgs.srv import GetModelState
 
+from pybullet_gazebo.engine.transforms import yaw_from_quaternion
+
 
 def wait_for_message(topic, msg_type, timeout=10.0):
     """The next message on `topic`; AssertionError naming the topic after `timeout` wall s."""
@@ -34,9 +36,7 @@ def model_pose(name):
     """(x, y, yaw) of a model from /gazebo/get_model_state."""
     state = service("/gazebo/get_model_state", GetModelState)(name, "")
     assert state.success, state.status_message
-    q = state.pose.orientation
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-    return state.pose.position.x, state.pose.position.y, yaw
+    return state.pose.position.x, state.pose.position.y, yaw_of(state.pose.orientation)
 
 
 def wait_until_sim_time(target, timeout=60.0):
@@ -56,8 +56,7 @@ def unwrap_angle(angle):
 
 def yaw_of(orientation):
     """Yaw [rad] of a geometry_msgs/Quaternion."""
-    q = orientation
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return yaw_from_quaternion((orientation.x, orientation.y, orientation.z, orientation.w))
 
 
 class NodeLog:

@@ -1,0 +1,45 @@
+"""Which robots touch which models, step by step (the ground excluded), and when each touch
+started. The history is bounded: a long run keeps the last MAX_EVENTS events and a count of
+all of them."""
+from collections import deque
+from dataclasses import dataclass
+from typing import Callable, Dict, Iterable, List, Tuple
+
+MAX_EVENTS = 10000
+
+
+@dataclass(frozen=True)
+class ContactEvent:
+    """The start of a touch between a robot and another model (the ground excluded)."""
+    sim_time: float                 # [s]
+    robot: str
+    other: str
+
+
+class ContactTracker:
+    def __init__(self, max_events=MAX_EVENTS):
+        self.events = deque(maxlen=max_events)   # the most recent touch onsets
+        self.event_count = 0                     # every onset since the start
+        self._touching = set()                   # (robot, other) pairs touching now
+
+    def update(self, client, sim_time, robots: Iterable[Tuple[str, int]],
+               owner_of: Dict[int, str], is_ground: Callable[[str], bool]):
+        """Reads Bullet's contact points of each (robot name, body) after a step."""
+        touching = set()
+        for name, body in robots:
+            for point in client.getContactPoints(bodyA=body):
+                owner = owner_of.get(point[2])
+                if owner is None or owner == name or is_ground(owner):
+                    continue
+                touching.add((name, owner))
+        for pair in sorted(touching - self._touching):
+            self.events.append(ContactEvent(sim_time, *pair))
+            self.event_count += 1
+        self._touching = touching
+
+    def touching(self) -> List[Tuple[str, str]]:
+        return sorted(self._touching)
+
+    def forget(self, name=None):
+        """Drops the current touches (of one model, or all)."""
+        self._touching = {pair for pair in self._touching if name is not None and name not in pair}

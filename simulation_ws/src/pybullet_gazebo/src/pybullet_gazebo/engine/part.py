@@ -1,0 +1,80 @@
+"""The contract of a robot part: what the World calls on each piece of a robot that Gazebo
+would run as a model plugin or a sensor (a diff drive, a laser, a joint-state publisher...).
+
+A part declares what it does by overriding the hooks below; every hook has a no-op default,
+so the World calls them all and never probes a part for what it can do. Per physics step:
+
+    before_step(now, dt)   the step that starts at sim time `now` [s] is about to run (dt [s])
+    after_step(now)        the step ended; `now` is the new sim time [s]
+    due(now) -> bool       a reading is due now; if so the World calls measure(now) at once
+    measure(now)           the reading (LaserScanData, Odometry, JointStates, ...): plain data
+
+and on demand:
+
+    reset()                simulation reset: forget commands, restart timers
+    reseed(rng)            take this numpy Generator for any noise (reset_simulation)
+    next_command_time()    [s] sim time at which the part next reads a command, or None if
+                           it takes none (lockstep waits for a controller's answer until then)
+    positive_turn_direction()  'clockwise' / 'counter-clockwise' for a drive, else None
+
+A part class is built by `build(context, spec)` from the `<gazebo>` tag it stands in for
+(a PluginSpec or a RaySensorSpec), with a PartContext: everything it may need of its robot.
+`registry.py` maps each tag key to its class; the ROS adapter's `ros/bindings.py` maps the
+same key to the publishers and subscribers of the part. A new part is one Part subclass in
+the registry plus one binding.
+"""
+from dataclasses import dataclass
+from typing import Callable, Dict, Optional
+
+from .specs import RobotSpec
+
+
+@dataclass
+class PartContext:
+    """What a part may use of the robot it belongs to. Nothing here is ROS."""
+    client: object                  # the pybullet client (passed in, never a global)
+    body_id: int                    # the robot's Bullet multibody
+    model_name: str
+    joints: Dict[str, int]          # URDF joint name -> Bullet joint index
+    links: Dict[str, int]           # URDF link name -> Bullet link index (root: -1)
+    description: RobotSpec          # the parsed URDF and its <gazebo> tags
+    caster: object                  # the world's RayCaster
+    rng: object                     # numpy Generator for noise
+    warn: Callable[[str], None]     # reports a problem (prefixed with the model's name)
+    command_timeout: float = 0.0    # [s] of sim time without a command before a drive stops
+    legacy_mode_swaps: bool = False  # diff drives emulate Kinetic's legacyMode true
+
+
+class Part:
+    """Base class of every robot part; see the module docstring for the contract."""
+
+    KEY: str = ""                   # the <plugin filename> or <sensor type> it stands in for
+
+    @classmethod
+    def build(cls, context: PartContext, spec) -> "Part":
+        raise NotImplementedError("%s does not say how to build it from a <gazebo> tag"
+                                  % cls.__name__)
+
+    def before_step(self, now: float, dt: float) -> None:
+        pass
+
+    def after_step(self, now: float) -> None:
+        pass
+
+    def due(self, now: float) -> bool:
+        return False
+
+    def measure(self, now: float):
+        return None
+
+    def reset(self) -> None:
+        pass
+
+    def reseed(self, rng) -> None:
+        pass
+
+    def next_command_time(self) -> Optional[float]:
+        return None
+
+    def positive_turn_direction(self) -> Optional[str]:
+        return None

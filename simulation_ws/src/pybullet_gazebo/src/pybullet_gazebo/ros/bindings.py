@@ -1,0 +1,144 @@
+"""How each robot part meets ROS: one Binding class per part KEY (the Gazebo plugin or sensor
+type the part stands in for), in the table BINDINGS. A binding opens the part's publishers and
+subscribers under the robot's namespace, turns its readings into messages stamped with the
+step's sim time, and closes them when the robot goes. A part whose KEY has no binding is
+reported by name when its robot is bound.
+
+  ray (libgazebo_ros_laser.so)      publishes the plugin's topicName (sensor_msgs/LaserScan)
+  libgazebo_ros_diff_drive.so       subscribes commandTopic (geometry_msgs/Twist), publishes
+                                    odometryTopic (nav_msgs/Odometry) and TF odometryFrame ->
+                                    robotBaseFrame on /tf, each only while someone listens
+"""
+from dataclasses import dataclass
+from typing import Callable, Dict, List
+
+import rospy
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
+from tf2_msgs.msg import TFMessage
+
+from pybullet_gazebo.engine.diff_drive import DiffDrive
+from pybullet_gazebo.engine.ray_sensor import RaySensor
+from pybullet_gazebo.ros import conversions
+
+
+@dataclass
+class BindingContext:
+    """What the simulator node lends every binding."""
+    tf_publisher: Callable[[], rospy.Publisher]   # the node's /tf publisher, made on first use
+    command_arrived: Callable[[], None]           # tells lockstep a command came in
+    debug: bool = False
+
+
+class Binding:
+    """Base class: a part's ROS side. `publish` gets each reading of the part."""
+
+    def __init__(self, robot, part, context: BindingContext):
+        self.robot = robot
+        self.part = part
+        self.context = context
+        self.publishers: List[rospy.Publisher] = []
+        self.subscribers: List[rospy.Subscriber] = []
+
+    def topic(self, name):
+        """A part's topic name resolved in its robot's namespace (absolute names stay)."""
+        return rospy.names.ns_join(self.robot.namespace or "/", name)
+
+    def publish(self, data, stamp) -> bool:
+        """Publishes one reading; True when it was a scan (lockstep counts scans)."""
+        return False
+
+    def commands_heard(self) -> bool:
+        """Whether a controller publishes on one of this part's command topics."""
+        return any(s.get_num_connections() for s in self.subscribers)
+
+    def close(self):
+        for subscriber in self.subscribers:
+            subscriber.unregister()
+        for publisher in self.publishers:
+            publisher.unregister()
+
+
+class LaserBinding(Binding):
+    def __init__(self, robot, part, context):
+        super().__init__(robot, part, context)
+        self.scans = rospy.Publisher(self.topic(part.topic), LaserScan, queue_size=1)
+        self.publishers.append(self.scans)
+
+    def publish(self, data, stamp):
+        self.scans.publish(conversions.scan_to_msg(data, stamp))
+        return True
+
+
+class DriveBinding(Binding):
+    def __init__(self, robot, part, context):
+        super().__init__(robot, part, context)
+        self.odometry = rospy.Publisher(self.topic(part.odometry_topic), Odometry, queue_size=1)
+        self.publishers.append(self.odometry)
+        # /tf is advertised once a robot needs it (an empty world offers no /tf, as Gazebo)
+        self.tf = context.tf_publisher() if part.publish_odom_tf else None
+        self.subscribers.append(rospy.Subscriber(self.topic(part.command_topic), Twist,
+                                                 self._on_command, queue_size=1))
+
+    def _on_command(self, msg):
+        drive = self.part
+        if not conversions.is_finite_twist(msg):
+            rospy.logwarn_throttle(5.0, "ignored a %s command for '%s' with NaN or inf: %s"
+                                   % (drive.command_topic, self.robot.name,
+                                      [msg.linear.x, msg.angular.z]))
+        else:
+            if self.context.debug:         # a per-message hot path: no work when not asked
+                rospy.logdebug_throttle(1.0, "%s for '%s': linear.x %.3f, angular.z %.3f"
+                                        % (drive.command_topic, self.robot.name, msg.linear.x,
+                                           msg.angular.z))
+            # Not under the world's lock: the loop holds it while it steps, and waiting for
+            # it here delayed commands by whole steps when running free. Setting the command
+            # is one attribute write, read by the drive at its next update.
+            drive.set_command(msg.linear.x, msg.angular.z)
+        self.context.command_arrived()
+
+    def publish(self, data, stamp):
+        odometry_heard = self.odometry.get_num_connections() > 0
+        tf = self.tf
+        tf_heard = tf is not None and tf.get_num_connections() > 0
+        if odometry_heard or tf_heard:
+            odometry, transform = conversions.odometry_to_msgs(data, self.part, stamp)
+            if odometry_heard:
+                self.odometry.publish(odometry)
+            if tf_heard:
+                tf.publish(TFMessage([transform]))
+        return False
+
+
+# part KEY -> its ROS binding
+BINDINGS: Dict[str, type] = {
+    RaySensor.KEY: LaserBinding,
+    DiffDrive.KEY: DriveBinding,
+}
+
+
+class RobotBindings:
+    """The bindings of every part of one robot."""
+
+    def __init__(self, robot, context: BindingContext, warn=rospy.logwarn):
+        self.by_part = {}
+        for part in robot.parts:
+            binding_class = BINDINGS.get(part.KEY)
+            if binding_class is None:
+                warn("model '%s': part %s (%s) has no ROS binding; it publishes nothing"
+                     % (robot.name, type(part).__name__, part.KEY))
+                continue
+            self.by_part[id(part)] = binding_class(robot, part, context)
+
+    def publish(self, reading, stamp) -> bool:
+        binding = self.by_part.get(id(reading.part))
+        return binding.publish(reading.data, stamp) if binding is not None else False
+
+    def commands_heard(self) -> bool:
+        return any(b.commands_heard() for b in self.by_part.values())
+
+    def close(self):
+        for binding in self.by_part.values():
+            binding.close()
+        self.by_part.clear()

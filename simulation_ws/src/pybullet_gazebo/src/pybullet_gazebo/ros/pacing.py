@@ -1,0 +1,77 @@
+"""Wall-clock pacing of the simulation loop, kept out of the engine.
+
+RealTimePacer holds sim time to `real_time_factor` sim seconds per wall second (0 = as fast
+as the machine allows); when the machine falls more than half a second behind it does not try
+to catch up.
+
+Lockstep (see README, "Lockstep"): after a step that published a scan, the loop may step on
+until the drive next reads its command (`next_command_time`), and there waits until a
+controller has answered (a command counted since that scan), at most `timeout` wall seconds.
+The answer then reaches the wheels at the same sim time on every run.
+"""
+import threading
+import time
+
+
+class RealTimePacer:
+    def __init__(self, real_time_factor, sim_time=0.0):
+        self.real_time_factor = real_time_factor
+        self.restart(sim_time)
+
+    def restart(self, sim_time):
+        self._wall = time.monotonic()
+        self._sim = sim_time
+
+    def pace(self, sim_time):
+        """Sleeps until wall time catches up with `sim_time` [s] at the set factor."""
+        if self.real_time_factor <= 0:
+            return
+        target = self._wall + (sim_time - self._sim) / self.real_time_factor
+        delay = target - time.monotonic()
+        if delay > 0:
+            time.sleep(delay)
+        elif delay < -0.5:          # far behind (a slow machine): do not try to catch up
+            self.restart(sim_time)
+
+
+class Lockstep:
+    def __init__(self, enabled, timeout, on_timeout, is_shutdown):
+        self.enabled = enabled
+        self.timeout = timeout               # [s] wall
+        self.on_timeout = on_timeout         # called (throttled by the caller) on a time-out
+        self.is_shutdown = is_shutdown
+        self.commands = 0                    # commands received since the start
+        self._arrived = threading.Condition()
+        self._awaited = None                 # (commands counted at a scan, sim time needed by)
+
+    def command_arrived(self):
+        with self._arrived:
+            self.commands += 1
+            self._arrived.notify_all()
+
+    def expect_answer(self, commands_before, needed_at):
+        """A scan went out when `commands_before` commands had come; its answer is needed
+        before the step that starts at `needed_at` [s] (None: no part takes commands)."""
+        if self.enabled and needed_at is not None:
+            self._awaited = (commands_before, needed_at)
+
+    def forget(self):
+        self._awaited = None
+
+    def wait_if_due(self, sim_time, anyone_commands):
+        """Before a step at `sim_time`: waits for the awaited answer if it is needed now and
+        some controller publishes commands at all."""
+        awaited = self._awaited
+        if awaited is None or sim_time < awaited[1]:
+            return
+        self._awaited = None
+        if not anyone_commands():
+            return
+        deadline = time.monotonic() + self.timeout
+        with self._arrived:
+            while self.commands == awaited[0] and not self.is_shutdown():
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    self.on_timeout()
+                    return
+                self._arrived.wait(min(left, 0.1))
