@@ -122,7 +122,7 @@ def test_contact_history_is_bounded_but_counted():
     client = Client()
     for step in range(10):                   # touch, let go, touch, ...: 5 onsets
         client.touch = step % 2 == 0
-        tracker.update(client, step * 0.1, [("robot", 1)], {7: "wall"}, lambda _: False)
+        tracker.update(client, step * 0.1, [("robot", 1)], {7: "wall"}, grounds=set())
     assert tracker.event_count == 5
     assert [round(e.sim_time, 1) for e in tracker.events] == [0.4, 0.6, 0.8]
     assert tracker.touching() == []

@@ -3,7 +3,7 @@ started. The history is bounded: a long run keeps the last MAX_EVENTS events and
 all of them."""
 from collections import deque
 from dataclasses import dataclass
-from typing import Callable, Dict, Iterable, List, Tuple
+from typing import AbstractSet, Dict, Iterable, List, Tuple
 
 MAX_EVENTS = 10000
 
@@ -23,13 +23,14 @@ class ContactTracker:
         self._touching = set()                   # (robot, other) pairs touching now
 
     def update(self, client, sim_time, robots: Iterable[Tuple[str, int]],
-               owner_of: Dict[int, str], is_ground: Callable[[str], bool]):
-        """Reads Bullet's contact points of each (robot name, body) after a step."""
+               owner_of: Dict[int, str], grounds: AbstractSet[str]):
+        """Reads Bullet's contact points of each (robot name, body) after a step; touches of
+        the models named in `grounds` are not counted."""
         touching = set()
         for name, body in robots:
             for point in client.getContactPoints(bodyA=body):
                 owner = owner_of.get(point[2])
-                if owner is None or owner == name or is_ground(owner):
+                if owner is None or owner == name or owner in grounds:
                     continue
                 touching.add((name, owner))
         for pair in sorted(touching - self._touching):

@@ -55,6 +55,8 @@ class World:
         self.contacts = ContactTracker()
         self._body_owner: Dict[int, str] = {}
         self._robots: Optional[List[Robot]] = None  # cache of robots()
+        self._stepped = ([], [])                    # cache: (robot, part) pairs, (name, body)
+        self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
 
         client.resetSimulation()
@@ -75,21 +77,19 @@ class World:
     def step(self) -> List[Reading]:
         """Advances physics by one fixed step; returns the parts' readings now due."""
         now = self.sim_time
-        robots = self.robots()
-        for robot in robots:
-            for part in robot.parts:
-                part.before_step(now, self.step_size)
+        self.robots()                       # refreshes the caches after a spawn or delete
+        parts, bodies = self._stepped
+        for _, part in parts:
+            part.before_step(now, self.step_size)
         self.client.stepSimulation()
         self.step_count += 1
         now = self.sim_time
         readings = []
-        for robot in robots:
-            for part in robot.parts:
-                part.after_step(now)
-                if part.due(now):
-                    readings.append(Reading(robot, part, part.measure(now)))
-        self.contacts.update(self.client, now, ((r.name, r.body_id) for r in robots),
-                             self._body_owner, lambda owner: self.entities[owner].is_ground)
+        for robot, part in parts:
+            part.after_step(now)
+            if part.due(now):
+                readings.append(Reading(robot, part, part.measure(now)))
+        self.contacts.update(self.client, now, bodies, self._body_owner, self._grounds)
         return readings
 
     def next_command_time(self):
@@ -106,6 +106,8 @@ class World:
     def robots(self) -> List[Robot]:
         if self._robots is None:         # stepped 200 times a second: kept until one comes or goes
             self._robots = [e.robot for e in self.entities.values() if e.robot is not None]
+            self._stepped = ([(r, p) for r in self._robots for p in r.parts],
+                             [(r.name, r.body_id) for r in self._robots])
         return list(self._robots)
 
     def entity(self, name) -> Entity:
@@ -145,6 +147,7 @@ class World:
             self.client.removeBody(body)
             self._body_owner.pop(body, None)
         del self.entities[name]
+        self._grounds.discard(name)
         self._robots = None
         self.contacts.forget(name)
 
@@ -242,6 +245,8 @@ class World:
         self.entities[model.name] = Entity(
             model.name, built.body_ids, built.link_offsets, built.inertial_offsets, model.pose,
             model.static, is_ground=built.is_ground, shapes=built.shapes)
+        if built.is_ground:
+            self._grounds.add(model.name)
         for body, body_shapes in zip(built.body_ids, built.shapes):
             self._body_owner[body] = model.name
             if built.is_ground:
