@@ -85,9 +85,11 @@ def model_path_from_env(package_models_dir):
     return path
 
 
-def find_world(name_or_path, worlds_dir):
+def find_world(name_or_path, worlds_dir, resource_path=()):
     """The absolute path of a world given as `world02`, `world02.world` (looked up in
-    worlds_dir) or a path to a .world file. Raises WorldFileError listing the known worlds."""
+    worlds_dir) or a path to a .world file. A relative path is also looked up in each folder
+    of `resource_path`, as Gazebo looks up `worlds/empty.world` in GAZEBO_RESOURCE_PATH.
+    Raises WorldFileError listing the known worlds."""
     text = (name_or_path or "").strip()
     candidates = []
     if text and "/" not in text and os.sep not in text:
@@ -95,6 +97,8 @@ def find_world(name_or_path, worlds_dir):
                                        else text + ".world"))
     if text:
         candidates.append(text)
+    if text and not os.path.isabs(text):
+        candidates.extend(os.path.join(folder, text) for folder in resource_path if folder)
     for candidate in candidates:
         if os.path.isfile(candidate):
             return os.path.abspath(candidate)
