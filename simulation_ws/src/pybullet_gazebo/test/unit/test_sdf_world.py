@@ -153,6 +153,16 @@ def test_find_world_unknown_lists_the_known_worlds(name):
         "or a path to a .world file" % (name, MY_WORLDS))
 
 
+def test_find_world_looks_up_relative_paths_in_the_resource_path(monkeypatch, tmp_path):
+    # gazebo_ros's default world_name, worlds/empty.world, is relative to GAZEBO_RESOURCE_PATH
+    monkeypatch.chdir(tmp_path)
+    package = os.path.join(SRC, "pybullet_gazebo")
+    assert find_world("worlds/empty.world", MY_WORLDS, ["", "/nonexistent", package]) == \
+        os.path.join(package, "worlds", "empty.world")
+    with pytest.raises(WorldFileError):
+        find_world("worlds/empty.world", MY_WORLDS, ["/nonexistent"])
+
+
 def test_find_world_finds_the_tutorial_worlds():
     assert find_world("world02", MY_WORLDS) == os.path.join(MY_WORLDS, "world02.world")
     assert find_world("world01.world", MY_WORLDS) == os.path.join(MY_WORLDS, "world01.world")
