@@ -28,6 +28,9 @@ APT_PACKAGES=(
   python3-rospy python3-rostest python3-rosunit librostest-dev python3-roslaunch
   python3-rosmaster rosout rosbash python3-rostopic python3-rosservice python3-rosnode
   python3-rosparam python3-rosmsg python3-rosbag ros-robot-state-publisher
+  # what programs written for Gazebo import or run beside it: tf (the series' later
+  # programs: `from tf import transformations`), joint_state_publisher, tf2_tools (view_frames)
+  python3-tf joint-state-publisher tf2-tools
 )
 
 STEP="check machine"
