@@ -10,6 +10,8 @@ Plugin parameters, read as Noetic reads them (default in brackets):
   wheelAcceleration [0 = no limit, m/s^2 of wheel rim speed]
   updateRate [100 Hz; <= 0 = every step]  wheel targets and odometry are updated at this
                              rate of sim time
+  robotNamespace [absent]    namespace of the topics; when absent, the spawn's (kept as
+                             own_namespace for the ROS side, which names topics and frames)
   commandTopic [cmd_vel], odometryTopic [odom], odometryFrame [odom],
   robotBaseFrame [base_footprint], odometrySource [world | encoder]
   publishTf [true]           false: Noetic publishes no odometry at all (due() stays false)
@@ -100,6 +102,8 @@ class DiffDrive(Part):
         read = ParameterReader(params, where, label="<%s>")
         text, number, boolean = read.text, read.number, read.boolean
 
+        own_namespace = params.get("robotNamespace")
+        self.own_namespace = own_namespace.strip() if own_namespace is not None else None
         self.command_topic = text("commandTopic", "cmd_vel")
         self.odometry_topic = text("odometryTopic", "odom")
         self.odometry_frame = text("odometryFrame", "odom")

@@ -49,6 +49,8 @@ class Part:
     """Base class of every robot part; see the module docstring for the contract."""
 
     KEY: str = ""                   # the <plugin filename> or <sensor type> it stands in for
+    # the plugin's own <robotNamespace>, None when absent: the ROS side then uses the spawn's
+    own_namespace: Optional[str] = None
 
     @classmethod
     def build(cls, context: PartContext, spec) -> "Part":

@@ -11,7 +11,8 @@ from the generator passed in (seedable), and a noisy return is kept inside
 
 Plugin parameters read (libgazebo_ros_laser.so): `topicName` (Noetic's default "/world"),
 `frameName` (default: the sensor's link name; Noetic's own default is "/world"; a leading
-"/" is dropped, as tf does). The ROS adapter publishes `measure()`'s LaserScanData on
+"/" is dropped, as tf does), `robotNamespace` (kept as `own_namespace`; None when absent).
+The ROS adapter publishes `measure()`'s LaserScanData on
 `topic` with `frame_id`, stamped with the sim time passed in. Measurements are due at
 `update_rate` [Hz] of sim time (0 = every step).
 """
@@ -59,6 +60,8 @@ class RaySensor(Part):
         self._caster = caster
         self.rng = rng                       # numpy Generator; reseed() swaps it on reset
         params = spec.plugin.params if spec.plugin is not None else {}
+        own_namespace = params.get("robotNamespace")      # None: the spawn's namespace
+        self.own_namespace = own_namespace.strip() if own_namespace is not None else None
         self.topic = params.get("topicName", "/world").strip()
         self.frame_id = params.get("frameName", spec.link).strip().lstrip("/")
         self.update_rate = float(spec.update_rate)                   # [Hz]

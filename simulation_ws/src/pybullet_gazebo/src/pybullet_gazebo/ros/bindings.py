@@ -8,6 +8,11 @@ reported by name when its robot is bound.
   libgazebo_ros_diff_drive.so       subscribes commandTopic (geometry_msgs/Twist), publishes
                                     odometryTopic (nav_msgs/Odometry) and TF odometryFrame ->
                                     robotBaseFrame on /tf, each only while someone listens
+
+Names as gazebo_ros gives them with several robots (robot_namespace.py): topics in the
+plugin's <robotNamespace> or the spawn's namespace; the laser's frame prefixed by the
+`tf_prefix` parameter found from that namespace, the drive's frames by it or, when there is
+none, by the namespace itself (read once, when the robot is bound).
 """
 from dataclasses import dataclass
 from typing import Callable, Dict, List
@@ -20,7 +25,7 @@ from tf2_msgs.msg import TFMessage
 
 from pybullet_gazebo.engine.diff_drive import DiffDrive
 from pybullet_gazebo.engine.ray_sensor import RaySensor
-from pybullet_gazebo.ros import conversions
+from pybullet_gazebo.ros import conversions, robot_namespace
 
 
 @dataclass
@@ -40,10 +45,16 @@ class Binding:
         self.context = context
         self.publishers: List[rospy.Publisher] = []
         self.subscribers: List[rospy.Subscriber] = []
+        self.namespace = robot_namespace.plugin_namespace(robot.namespace, part.own_namespace)
 
     def topic(self, name):
-        """A part's topic name resolved in its robot's namespace (absolute names stay)."""
-        return rospy.names.ns_join(self.robot.namespace or "/", name)
+        """A part's topic name resolved in its namespace (absolute names stay)."""
+        return robot_namespace.topic_name(self.namespace, name)
+
+    def frame(self, name, fall_back_to_namespace):
+        """A part's frame with its tf prefix (see the module docstring)."""
+        return robot_namespace.resolve_frame(
+            robot_namespace.tf_prefix(self.namespace, fall_back_to_namespace), name)
 
     def publish(self, data, stamp) -> bool:
         """Publishes one reading; True when it was a scan (lockstep counts scans)."""
@@ -65,9 +76,10 @@ class LaserBinding(Binding):
         super().__init__(robot, part, context)
         self.scans = rospy.Publisher(self.topic(part.topic), LaserScan, queue_size=1)
         self.publishers.append(self.scans)
+        self.frame_id = self.frame(part.frame_id, fall_back_to_namespace=False)
 
     def publish(self, data, stamp):
-        self.scans.publish(conversions.scan_to_msg(data, stamp))
+        self.scans.publish(conversions.scan_to_msg(data, stamp, self.frame_id))
         return True
 
 
@@ -76,6 +88,8 @@ class DriveBinding(Binding):
         super().__init__(robot, part, context)
         self.odometry = rospy.Publisher(self.topic(part.odometry_topic), Odometry, queue_size=1)
         self.publishers.append(self.odometry)
+        self.frames = (self.frame(part.odometry_frame, fall_back_to_namespace=True),
+                       self.frame(part.robot_base_frame, fall_back_to_namespace=True))
         # /tf is advertised once a robot needs it (an empty world offers no /tf, as Gazebo)
         self.tf = context.tf_publisher() if part.publish_odom_tf else None
         self.subscribers.append(rospy.Subscriber(self.topic(part.command_topic), Twist,
@@ -103,7 +117,8 @@ class DriveBinding(Binding):
         tf = self.tf
         tf_heard = tf is not None and tf.get_num_connections() > 0
         if odometry_heard or tf_heard:
-            odometry, transform = conversions.odometry_to_msgs(data, self.part, stamp)
+            odometry, transform = conversions.odometry_to_msgs(data, self.part, stamp,
+                                                               self.frames)
             if odometry_heard:
                 self.odometry.publish(odometry)
             if tf_heard:

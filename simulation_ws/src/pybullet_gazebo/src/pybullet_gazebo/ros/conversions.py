@@ -36,10 +36,11 @@ def is_finite_twist(msg):
     return all(math.isfinite(v) for v in values)
 
 
-def scan_to_msg(scan, stamp):
+def scan_to_msg(scan, stamp, frame_id=None):
+    """frame_id: the scan's frame as the ROS side resolved it (None: the sensor's own)."""
     msg = LaserScan()
     msg.header.stamp = stamp
-    msg.header.frame_id = scan.frame_id
+    msg.header.frame_id = scan.frame_id if frame_id is None else frame_id
     msg.angle_min = scan.angle_min
     msg.angle_max = scan.angle_max
     msg.angle_increment = scan.angle_increment
@@ -51,17 +52,19 @@ def scan_to_msg(scan, stamp):
     return msg
 
 
-def odometry_to_msgs(odometry, drive, stamp):
-    """(nav_msgs/Odometry, TransformStamped odom -> base) as gazebo_ros_diff_drive sends."""
+def odometry_to_msgs(odometry, drive, stamp, frames=None):
+    """(nav_msgs/Odometry, TransformStamped odom -> base) as gazebo_ros_diff_drive sends.
+    frames: (odometry frame, base frame) as the ROS side resolved them (None: the drive's)."""
+    odometry_frame, base_frame = frames or (drive.odometry_frame, drive.robot_base_frame)
     msg = Odometry()
     msg.header.stamp = stamp
-    msg.header.frame_id = drive.odometry_frame
-    msg.child_frame_id = drive.robot_base_frame
+    msg.header.frame_id = odometry_frame
+    msg.child_frame_id = base_frame
     msg.pose.pose = pose_to_msg(odometry.pose)
     msg.twist.twist = twist_to_msg(odometry.linear, odometry.angular)
     transform = TransformStamped()
     transform.header = msg.header
-    transform.child_frame_id = drive.robot_base_frame
+    transform.child_frame_id = base_frame
     transform.transform.translation = Vector3(*odometry.pose.position)
     transform.transform.rotation = Quaternion(*odometry.pose.orientation)
     return msg, transform
