@@ -66,6 +66,7 @@ class SimulatorNode:
                 10.0, "lockstep: no cmd_vel within %.2f s of a scan; stepping on"
                 % params.lockstep_timeout))
         self._bindings = {}                       # robot name -> RobotBindings
+        self._running = False                     # run() is stepping
         self._tf_publisher = None
         self._binding_context = BindingContext(self._tf, self.lockstep.command_arrived,
                                                debug=params.debug)
@@ -127,6 +128,14 @@ class SimulatorNode:
 
     # --- the loop -------------------------------------------------------------------------
     def run(self):
+        self._running = True
+        try:
+            self._loop()
+        finally:
+            self._running = False
+            self._disconnect()
+
+    def _loop(self):
         while not rospy.is_shutdown():
             if self.paused:
                 time.sleep(0.01)
@@ -201,6 +210,13 @@ class SimulatorNode:
         return msg
 
     def shutdown(self):
+        """rospy's shutdown hook. Ctrl-C's handler runs on the main thread, the one stepping,
+        possibly in the middle of a step: while run() loops, it disconnects Bullet itself once
+        the loop has ended, never under a step."""
+        if not self._running:
+            self._disconnect()
+
+    def _disconnect(self):
         try:
             self.client.disconnect()
         except pybullet.error:
