@@ -30,8 +30,6 @@ if [ "$mode" != "--unit" ]; then
     echo "[test] rostest suites of $ws (catkin_make run_tests, one at a time)"
     source_ws() { source "$ROOT/$ws/devel/setup.bash"; }   # without this script's arguments
     set +u; source_ws; set -u
-    # simulation_ws's fault tests run the tutorial's controller, from catkin_ws
-    export ROS_PACKAGE_PATH="$ROS_PACKAGE_PATH:$ROOT/catkin_ws/src"
     export PATH="$ROOT/.venv/bin:$PATH"
     (cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 2>&1) > "$RESULTS/$ws-run_tests.log"
     # one progress line per suite; the full output stays in the log
