@@ -137,7 +137,9 @@ class GazeboServices:
     def set_model_state(self, req):
         state = req.model_state
         try:
-            pose = conversions.pose_from_msg(state.pose)
+            # Gazebo normalizes the quaternion (an all-zero one becomes identity), and the series'
+            # bug programs send only a position
+            pose = conversions.pose_from_msg(state.pose, zero_quaternion_is_identity=True)
             linear = (state.twist.linear.x, state.twist.linear.y, state.twist.linear.z)
             angular = (state.twist.angular.x, state.twist.angular.y, state.twist.angular.z)
             with self.sim.lock:
