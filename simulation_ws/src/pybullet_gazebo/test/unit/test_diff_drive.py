@@ -129,6 +129,20 @@ def test_positive_angular_z_turns_m2wr_clockwise(tmp_path, implicit_cylinders):
     assert mean_yaw_rate(sim) == pytest.approx(-0.4, rel=0.10)
 
 
+@pytest.mark.parametrize("urdf_legacy", ["false", "true"])
+def test_kinetic_legacy_mode_turns_m2wr_counter_clockwise_whatever_the_urdf_says(tmp_path,
+                                                                               urdf_legacy):
+    """The simulator's legacy_mode:=true: Kinetic's drive with legacyMode true, so a positive
+    angular.z turns m2wr counter-clockwise (REP 103) at +0.4 rad/s, with no warning."""
+    sim = Sim(tmp_path, dict(TUTORIAL_PARAMS, legacyMode=urdf_legacy), kinetic_legacy_mode=True)
+    assert sim.drive.legacy_mode is True
+    assert not any("legacyMode" in w for w in sim.warnings)
+    assert sim.drive.wheel_speeds(0.0, 0.3) == pytest.approx((0.6, -0.6))
+    sim.drive.set_command(0.0, 0.3)
+    sim.run(1.0)
+    assert mean_yaw_rate(sim) == pytest.approx(0.4, rel=0.10)
+
+
 @pytest.mark.parametrize("swaps,expected", [(False, -0.4), (True, 0.4)])
 def test_legacy_mode_true_is_ignored_as_in_noetic_unless_emulated(tmp_path, swaps, expected):
     params = dict(TUTORIAL_PARAMS, legacyMode="true")

@@ -20,6 +20,10 @@ Plugin parameters, read as Noetic reads them (default in brackets):
                              `true` only draws a warning, unless the component is built with
                              legacy_mode_swaps=True to emulate Kinetic and older, where
                              legacyMode true swapped the two wheels' formulas.
+                             kinetic_legacy_mode=True (the simulator's `legacy_mode` option)
+                             emulates Kinetic's drive with legacyMode true whatever the URDF
+                             says: the swapped formulas, so that m2wr turns counter-clockwise
+                             for a positive w (REP 103), as the series' later programs expect.
 
 Wheel speeds for a command (v [m/s], w [rad/s]): the joint NAMED by leftJoint turns at
 (v - w * separation / 2) / radius and the joint named by rightJoint at
@@ -88,10 +92,11 @@ class DiffDrive(Part):
     def build(cls, context: PartContext, plugin):
         return cls(context.client, context.body_id, context.joints, plugin, context.warn,
                    command_timeout=context.command_timeout,
-                   legacy_mode_swaps=context.legacy_mode_swaps)
+                   legacy_mode_swaps=context.legacy_mode_swaps,
+                   kinetic_legacy_mode=context.kinetic_legacy_mode)
 
     def __init__(self, client, body_id, joints, plugin, warn, command_timeout=0.0,
-                 legacy_mode_swaps=False):
+                 legacy_mode_swaps=False, kinetic_legacy_mode=False):
         self._client = client
         self.body_id = body_id
         self._warn = warn
@@ -138,8 +143,9 @@ class DiffDrive(Part):
                             "used" % (where, self.odometry_source))
             self.odometry_source = "world"
         legacy = boolean("legacyMode", False)
-        self.legacy_mode = bool(legacy and legacy_mode_swaps)    # whether the wheels swap
-        if legacy and not legacy_mode_swaps:
+        # whether the wheels swap
+        self.legacy_mode = bool(kinetic_legacy_mode or (legacy and legacy_mode_swaps))
+        if legacy and not (legacy_mode_swaps or kinetic_legacy_mode):
             self._warn_once("%s: <legacyMode>true is ignored, as ROS Noetic ignores it (removed "
                             "in Melodic): leftJoint gets (v - w*sep/2)/r and rightJoint "
                             "(v + w*sep/2)/r" % where)

@@ -43,6 +43,7 @@ class PartContext:
     warn: Callable[[str], None]     # reports a problem (prefixed with the model's name)
     command_timeout: float = 0.0    # [s] of sim time without a command before a drive stops
     legacy_mode_swaps: bool = False  # diff drives emulate Kinetic's legacyMode true
+    kinetic_legacy_mode: bool = False   # ... and act as if every URDF said legacyMode true
 
 
 class Part:

@@ -48,7 +48,7 @@ def load_body(client, spec: RobotSpec, pose: Pose):
 
 
 def make_robot(client, body, spec: RobotSpec, pose, namespace, contacts, caster, rng, warn,
-               command_timeout=0.0, legacy_mode_swaps=False) -> Robot:
+               command_timeout=0.0, legacy_mode_swaps=False, kinetic_legacy_mode=False) -> Robot:
     """The Robot of a loaded body: joints freed (Gazebo's joints are free until a plugin
     drives them), friction per link, collision groups, and its parts. SpawnError when a
     sensor sits on a link the URDF lacks or a part cannot be built; `warn` gets each tag the
@@ -67,7 +67,8 @@ def make_robot(client, body, spec: RobotSpec, pose, namespace, contacts, caster,
     context = PartContext(client, body, spec.name, joints, links, spec, caster, rng,
                           warn=lambda m: warn("model '%s': %s" % (spec.name, m)),
                           command_timeout=command_timeout,
-                          legacy_mode_swaps=legacy_mode_swaps)
+                          legacy_mode_swaps=legacy_mode_swaps,
+                          kinetic_legacy_mode=kinetic_legacy_mode)
     for plugin in spec.plugins:
         part_class = PLUGIN_PARTS.get(plugin.filename)
         if part_class is None:

@@ -35,11 +35,13 @@ class ModelNotFound(KeyError):
 
 class World:
     """Everything the simulator steps. `warn(message)` receives each problem once.
-    `legacy_mode_swaps`: diff drives with <legacyMode>true swap their wheels as Kinetic did."""
+    `legacy_mode_swaps`: diff drives with <legacyMode>true swap their wheels as Kinetic did.
+    `legacy_mode`: every diff drive behaves as Kinetic's with <legacyMode>true, whatever the
+    URDF says (the simulator's legacy_mode:=true)."""
 
     def __init__(self, client, spec: WorldSpec, step_size: float, seed: int = 0,
                  warn: Callable[[str], None] = print, command_timeout: float = 0.0,
-                 legacy_mode_swaps: bool = False):
+                 legacy_mode_swaps: bool = False, legacy_mode: bool = False):
         if not (step_size > 0.0 and math.isfinite(step_size)):
             raise ValueError("step_size %r must be a positive number of seconds" % step_size)
         self.client = client
@@ -48,6 +50,7 @@ class World:
         self.seed = seed
         self.command_timeout = command_timeout       # [s]; 0 = hold the last command for ever
         self.legacy_mode_swaps = legacy_mode_swaps
+        self.legacy_mode = legacy_mode
         self.warn = warn
         self.rng = np.random.default_rng(seed)
         self.step_count = 0
@@ -200,7 +203,8 @@ class World:
         try:
             robot = make_robot(self.client, body, spec, pose, namespace, contacts, self.caster,
                                self.rng, self.warn, command_timeout=self.command_timeout,
-                               legacy_mode_swaps=self.legacy_mode_swaps)
+                               legacy_mode_swaps=self.legacy_mode_swaps,
+                               kinetic_legacy_mode=self.legacy_mode)
             others = [(b, owner) for b, owner in self._body_owner.items()
                       if not self.entities[owner].is_ground]
             inside = overlapping(self.client, body, others)

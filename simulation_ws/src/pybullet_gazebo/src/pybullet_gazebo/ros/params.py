@@ -14,6 +14,9 @@ parameters (~name), with units:
   cmd_vel_timeout     [s] of sim time after which a robot stops without commands; 0 = never
   gui                 open pybullet's GUI window (needs a display)
   debug               log at debug level
+  legacy_mode         true: diff drives as Kinetic's with <legacyMode>true whatever the URDF
+                      says (m2wr turns counter-clockwise for a positive angular.z, as the
+                      series' later programs expect); false: Noetic's, Gazebo's (clockwise)
 Global: /use_sim_time (publish /clock).
 Each value is read with engine.parameters.ParameterReader: a bad one stops the node with a
 message naming the parameter, the value and the allowed range.
@@ -40,6 +43,7 @@ class SimulatorParams:
     cmd_vel_timeout: float = 0.0            # [s] sim
     gui: bool = False
     debug: bool = False
+    legacy_mode: bool = False
 
     @staticmethod
     def from_values(private, use_sim_time=True, where="gazebo"):
@@ -61,6 +65,7 @@ class SimulatorParams:
             cmd_vel_timeout=read.number("cmd_vel_timeout", d.cmd_vel_timeout, minimum=0.0),
             gui=read.boolean("gui", d.gui),
             debug=read.boolean("debug", d.debug),
+            legacy_mode=read.boolean("legacy_mode", d.legacy_mode),
         )
 
     @staticmethod

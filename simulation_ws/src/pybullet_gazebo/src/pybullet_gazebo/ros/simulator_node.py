@@ -53,7 +53,8 @@ class SimulatorNode:
         step = params.max_step_size or world_spec.physics.max_step_size
         self.world = World(self.client, world_spec, step, seed=params.seed,
                            warn=lambda m: rospy.logwarn(m),
-                           command_timeout=params.cmd_vel_timeout)
+                           command_timeout=params.cmd_vel_timeout,
+                           legacy_mode=params.legacy_mode)
         self.lock = threading.RLock()             # guards the world: loop vs. service threads
         self.paused = params.paused
         world_rtf = world_spec.physics.real_time_factor
@@ -88,6 +89,11 @@ class SimulatorNode:
                       "the world file's" if params.real_time_factor is None else
                       "~real_time_factor; the world file says %g" % world_rtf,
                       ", paused" if self.paused else "")
+        rospy.loginfo("diff drive: %s", "Kinetic's with legacyMode true (legacy_mode:=true): "
+                      "leftJoint gets v + w*sep/2; m2wr turns counter-clockwise for a positive "
+                      "angular.z" if params.legacy_mode else "Noetic's, as Gazebo (legacy_mode:="
+                      "false): leftJoint gets v - w*sep/2; m2wr turns clockwise for a positive "
+                      "angular.z")
 
     def _steps_per_period(self, rate):
         return max(1, int(round(1.0 / (rate * self.world.step_size))))
@@ -142,6 +148,8 @@ class SimulatorNode:
                 continue
             self.lockstep.wait_if_due(self.world.sim_time, self._commands_heard)
             with self.lock:
+                if rospy.is_shutdown():      # shutdown() may have disconnected Bullet
+                    break
                 readings = self.world.step()
                 commands_before = self.lockstep.commands
                 now = self.world.sim_time
@@ -218,6 +226,7 @@ class SimulatorNode:
 
     def _disconnect(self):
         try:
-            self.client.disconnect()
+            with self.lock:             # not in the middle of a step (rospy calls this from
+                self.client.disconnect()    # its signal handling thread)
         except pybullet.error:
             pass

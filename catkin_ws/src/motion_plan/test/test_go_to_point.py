@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""rostest: the project's go-to-point node (nodes/standin_go_to_point.py) takes m2wr from
+(0, 8), facing +x, to each goal within 0.3 m, as episode 6 of the series shows.
+
+For each goal: m2wr is put back at (0, 8) yaw 0 with /gazebo/set_model_state, the goal is set
+in des_pos_x/des_pos_y and /go_to_point_switch is called with data true; the test watches
+/odom until the robot is within 0.3 m and has stopped there (or `goal_timeout` s of sim time
+pass), then switches the node off. It prints, per goal, the nearest distance, the sim time
+taken and the touches /gazebo/contacts reported.
+Parameters (~): goals "x,y;x,y;..." [m], goal_timeout [s sim] (60), wall_timeout [s wall].
+"""
+import math
+import threading
+import unittest
+
+import rospy
+import rostest
+from gazebo_msgs.msg import ModelState
+from gazebo_msgs.srv import GetModelState, SetModelState
+from nav_msgs.msg import Odometry
+from std_srvs.srv import SetBool
+
+from pybullet_gazebo.ros.testing import ContactLog, service, sim_time, wait_for_message
+
+START = (0.0, 8.0)
+TOLERANCE = 0.3             # [m] the series' "done" distance
+
+
+def parse_goals(text):
+    return [tuple(float(v) for v in pair.split(",")) for pair in text.split(";") if pair.strip()]
+
+
+class GoToPointTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_go_to_point")
+        cls.goals = parse_goals(rospy.get_param("~goals"))
+        cls.goal_timeout = rospy.get_param("~goal_timeout", 60.0)
+        cls.wall_timeout = rospy.get_param("~wall_timeout", 100.0)
+        cls.lock = threading.Lock()
+        cls.odom = None
+        cls.contacts = ContactLog()
+        rospy.Subscriber("/odom", Odometry, cls.on_odom, queue_size=1)
+        wait_for_message("/odom", Odometry, timeout=60)
+        cls.switch = service("/go_to_point_switch", SetBool, timeout=30)
+        cls.set_state = service("/gazebo/set_model_state", SetModelState)
+        cls.get_state = service("/gazebo/get_model_state", GetModelState)
+
+    @classmethod
+    def on_odom(cls, msg):
+        with cls.lock:
+            p = msg.pose.pose.position
+            cls.odom = (msg.header.stamp.to_sec(), p.x, p.y, msg.twist.twist.linear.x,
+                        msg.twist.twist.angular.z)
+
+    def place_at_start(self):
+        state = ModelState(model_name="m2wr")
+        state.pose.position.x, state.pose.position.y = START
+        state.pose.position.z = self.get_state("m2wr", "").pose.position.z
+        state.pose.orientation.w = 1.0
+        self.assertTrue(self.set_state(state).success)
+        settle = sim_time() + 0.5
+        while sim_time() < settle and not rospy.is_shutdown():
+            rospy.sleep(0.05)
+
+    def run_to(self, goal):
+        """(nearest distance [m], sim time [s] to get within TOLERANCE and stop, touches)."""
+        self.place_at_start()
+        rospy.set_param("des_pos_x", goal[0])
+        rospy.set_param("des_pos_y", goal[1])
+        touches_before = len(self.contacts.touches)
+        start = sim_time()
+        self.switch(True)
+        nearest, reached_at, wall_start = math.inf, None, rospy.get_rostime()
+        deadline = rospy.Time.now()
+        import time
+        wall_end = time.monotonic() + self.wall_timeout
+        try:
+            while not rospy.is_shutdown() and time.monotonic() < wall_end:
+                with self.lock:
+                    t, x, y, v, w = self.odom
+                distance = math.hypot(goal[0] - x, goal[1] - y)
+                nearest = min(nearest, distance)
+                if distance < TOLERANCE and abs(v) < 0.05 and abs(w) < 0.05:
+                    reached_at = t - start
+                    break
+                if t - start > self.goal_timeout:
+                    break
+                time.sleep(0.01)
+        finally:
+            self.switch(False)
+        touches = self.contacts.touches[touches_before:]
+        rospy.loginfo("goal (%.1f, %.1f): nearest %.3f m, stopped within %.1f m after %s s of "
+                      "sim time, %d touch event(s) %s", goal[0], goal[1], nearest, TOLERANCE,
+                      "%.2f" % reached_at if reached_at is not None else "(never)",
+                      len(touches), touches[:3])
+        print("FIGURES goal=(%.1f,%.1f) nearest=%.3f time=%s contacts=%d"
+              % (goal[0], goal[1], nearest, reached_at, len(touches)))
+        return nearest, reached_at, touches
+
+    def test_reaches_each_goal_from_0_8(self):
+        failures = []
+        for goal in self.goals:
+            nearest, reached_at, touches = self.run_to(goal)
+            if reached_at is None or touches:
+                failures.append("goal %s: nearest %.2f m, reached after %s s, touches %s"
+                                % (goal, nearest, reached_at, touches[:3]))
+        self.assertEqual(failures, [])
+
+
+if __name__ == "__main__":
+    rostest.rosrun("motion_plan", "go_to_point", GoToPointTest)
