@@ -61,8 +61,11 @@ class Bug2:
         state.model_name = "m2wr"
         state.pose.position.x, state.pose.position.y = self.start
         answer = self.set_model_state(state)
-        rospy.loginfo("robot placed at (%.2f, %.2f): %s", self.start[0], self.start[1],
-                      answer.status_message)
+        if answer.success:
+            rospy.loginfo("robot placed at (%.2f, %.2f)", *self.start)
+        else:
+            rospy.logwarn("robot not placed at (%.2f, %.2f): %s", self.start[0], self.start[1],
+                          answer.status_message)
 
     def switch(self, state):
         if state == self.state:
@@ -93,11 +96,11 @@ class Bug2:
             self.switch(GO)
 
     def spin(self):
-        self.place_robot()
         rate = rospy.Rate(RATE)
-        rospy.sleep(0.5)                 # let /odom report the new pose
         while self.position is None and not rospy.is_shutdown():
-            rate.sleep()
+            rate.sleep()                 # the robot is there once its /odom comes
+        self.place_robot()
+        rospy.sleep(0.5)                 # let /odom report the new pose
         self.switch(GO)
         while not rospy.is_shutdown() and self.state != DONE:
             self.step()

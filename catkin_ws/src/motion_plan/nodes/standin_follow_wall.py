@@ -20,12 +20,13 @@ from geometry_msgs.msg import Twist
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import SetBool, SetBoolResponse
 
-WALL_DISTANCE = 0.6         # [m] from the laser to the wall on the right, when following
+WALL_DISTANCE = 0.55        # [m] from the laser to the wall on the right, when following
 SEES_WALL = 1.2             # [m] a region nearer than this holds a wall
 BLOCKED = 0.7               # [m] the front nearer than this: turn left in place
 FORWARD = 0.35              # [m/s] following
 TURN = 0.6                  # [rad/s] turning left in place
 RATE = 20.0                 # [Hz] of ROS time
+WRAP_TIME = 7.0             # [s] arcing right round a wall's end before going straight on
 
 FIND, TURN_LEFT, FOLLOW = "find the wall", "turn left", "follow the wall"
 
@@ -38,15 +39,18 @@ def regions(ranges):
             for i, name in enumerate(("right", "fright", "front", "fleft", "left"))}
 
 
-def decide(region):
-    """(state, linear.x [m/s], angular.z [rad/s], REP 103 signs) for the five regions."""
+def decide(region, lost_for):
+    """(state, linear.x [m/s], angular.z [rad/s], REP 103 signs) for the five regions;
+    lost_for [s]: how long ago the wall was last on the right (inf: never)."""
     if region["front"] < BLOCKED or region["fright"] < BLOCKED * 0.6:
         return TURN_LEFT, 0.0, TURN
     wall = min(region["right"], region["fright"] / 1.2)    # fright beams look ahead at the wall
     if wall < SEES_WALL:
         steer = max(-0.8, min(0.8, 2.0 * (WALL_DISTANCE - wall)))   # too near: left
         return FOLLOW, FORWARD, steer
-    return FIND, 0.25, -0.5                                  # arc right towards a wall
+    if lost_for < WRAP_TIME:                 # the wall ended: turn right round its end
+        return FIND, 0.25, -0.5
+    return FIND, 0.3, 0.0                    # no wall near: straight on until one comes
 
 
 class WallFollower:
@@ -55,6 +59,7 @@ class WallFollower:
         self.active = active
         self.state = None
         self.region = None
+        self.wall_seen_at = -float("inf")    # [s] ROS time the wall was last beside it
         self.cmd_vel = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
         rospy.Subscriber("/m2wr/laser/scan", LaserScan, self.on_scan, queue_size=1)
         rospy.Service("/wall_follower_switch", SetBool, self.on_switch)
@@ -71,7 +76,10 @@ class WallFollower:
         rate = rospy.Rate(RATE)
         while not rospy.is_shutdown():
             if self.active and self.region is not None:
-                state, linear, angular = decide(self.region)
+                now = rospy.get_time()
+                state, linear, angular = decide(self.region, now - self.wall_seen_at)
+                if state != FIND:
+                    self.wall_seen_at = now
                 if state != self.state:
                     rospy.loginfo("state: %s", state)
                     self.state = state

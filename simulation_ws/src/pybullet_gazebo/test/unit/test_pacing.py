@@ -61,3 +61,45 @@ def test_pacer_holds_the_real_time_factor():
     start = time.monotonic()
     unlimited.pace(100.0)
     assert time.monotonic() - start < 0.05
+
+
+def test_a_loop_controller_is_woken_before_the_wait_and_its_command_counts():
+    """A controller on rospy.Rate publishes when /clock reaches its tick, not on a scan: the
+    loop brings /clock up to now (before_wait) and that command is the awaited answer."""
+    woken = []
+    lock = Lockstep(True, 5.0, on_timeout=lambda: None, is_shutdown=lambda: False,
+                    before_wait=lambda: (woken.append(True),
+                                         threading.Timer(0.05, lock.command_arrived).start()))
+    lock.expect_answer(commands_before=lock.commands, needed_at=0.05)
+    start = time.monotonic()
+    lock.wait_if_due(0.05, lambda: True)
+    assert woken == [True] and time.monotonic() - start < 2.0 and lock.commands == 1
+
+
+def test_no_wake_up_when_the_answer_came_already():
+    woken = []
+    lock = Lockstep(True, 5.0, on_timeout=lambda: None, is_shutdown=lambda: False,
+                    before_wait=lambda: woken.append(True))
+    lock.expect_answer(commands_before=lock.commands, needed_at=0.05)
+    lock.command_arrived()
+    lock.wait_if_due(0.05, lambda: True)
+    assert woken == []
+
+
+def test_silent_controllers_cost_one_timeout_until_a_command_comes_again():
+    """Controllers switched off: one wait of `timeout`, then none, until a command arrives;
+    then lockstep waits for answers again."""
+    lock, timeouts = make(timeout=0.2)
+    start = time.monotonic()
+    for scan in range(5):
+        lock.expect_answer(commands_before=lock.commands, needed_at=0.05 * scan)
+        lock.wait_if_due(0.05 * scan, lambda: True)
+    assert len(timeouts) == 1 and time.monotonic() - start < 0.6
+    lock.command_arrived()                             # a controller is back
+    lock.expect_answer(commands_before=lock.commands, needed_at=1.0)
+    threading.Timer(0.1, lock.command_arrived).start()
+    lock.wait_if_due(1.0, lambda: True)
+    assert lock.commands == 2 and len(timeouts) == 1
+    lock.expect_answer(commands_before=lock.commands, needed_at=1.05)
+    lock.wait_if_due(1.05, lambda: True)               # silent again: waits and says so
+    assert len(timeouts) == 2

@@ -8,6 +8,13 @@ Lockstep (see README, "Lockstep"): after a step that published a scan, the loop 
 until the drive next reads its command (`next_command_time`), and there waits until a
 controller has answered (a command counted since that scan), at most `timeout` wall seconds.
 The answer then reaches the wheels at the same sim time on every run.
+
+Controllers that publish from their own loop (rospy.Rate, as the series' later programs do)
+wake on /clock, not on scans: before waiting, `before_wait` is called (the node brings /clock
+up to now), so a loop whose tick fell since the last /clock publishes its command before the
+drive reads it. When no command comes within `timeout` (every controller switched off, say),
+lockstep reports it once and stops waiting until the next command arrives, instead of
+stalling `timeout` at every scan.
 """
 import threading
 import time
@@ -35,12 +42,14 @@ class RealTimePacer:
 
 
 class Lockstep:
-    def __init__(self, enabled, timeout, on_timeout, is_shutdown):
+    def __init__(self, enabled, timeout, on_timeout, is_shutdown, before_wait=lambda: None):
         self.enabled = enabled
         self.timeout = timeout               # [s] wall
-        self.on_timeout = on_timeout         # called (throttled by the caller) on a time-out
+        self.on_timeout = on_timeout         # called once per silence (see the docstring)
         self.is_shutdown = is_shutdown
+        self.before_wait = before_wait       # called before waiting for an answer not yet in
         self.commands = 0                    # commands received since the start
+        self.silent_at = None                # commands counted when a wait last timed out
         self._arrived = threading.Condition()
         self._awaited = None                 # (commands counted at a scan, sim time needed by)
 
@@ -65,13 +74,16 @@ class Lockstep:
         if awaited is None or sim_time < awaited[1]:
             return
         self._awaited = None
-        if not anyone_commands():
-            return
+        if self.commands != awaited[0] or self.commands == self.silent_at \
+                or not anyone_commands():
+            return                  # answered already, controllers silent, or none at all
+        self.before_wait()
         deadline = time.monotonic() + self.timeout
         with self._arrived:
             while self.commands == awaited[0] and not self.is_shutdown():
                 left = deadline - time.monotonic()
                 if left <= 0:
+                    self.silent_at = self.commands
                     self.on_timeout()
                     return
                 self._arrived.wait(min(left, 0.1))

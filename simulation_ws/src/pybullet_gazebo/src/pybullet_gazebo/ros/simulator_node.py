@@ -63,9 +63,10 @@ class SimulatorNode:
         self.pacer = RealTimePacer(self.real_time_factor, self.world.sim_time)
         self.lockstep = Lockstep(
             params.lockstep, params.lockstep_timeout, is_shutdown=rospy.is_shutdown,
-            on_timeout=lambda: rospy.logwarn_throttle(
-                10.0, "lockstep: no cmd_vel within %.2f s of a scan; stepping on"
-                % params.lockstep_timeout))
+            on_timeout=lambda: rospy.loginfo(
+                "lockstep: no cmd_vel within %.2f s of a scan; stepping on without waiting "
+                "until a cmd_vel comes again" % params.lockstep_timeout),
+            before_wait=self._clock_now)
         self._bindings = {}                       # robot name -> RobotBindings
         self._running = False                     # run() is stepping
         self._tf_publisher = None
@@ -187,6 +188,14 @@ class SimulatorNode:
         if model_states_due:
             self.model_states_pub.publish(self.model_states())
         return scans
+
+    def _clock_now(self):
+        """/clock at the present sim time unless it went out this step: wakes controllers
+        that loop on rospy.Rate, whose tick may have fallen since the last /clock."""
+        with self.lock:
+            if self.world.step_count != self._last_clock_step and self._clock_due(force=True):
+                self.clock_pub.publish(Clock(conversions.stamp_of(self.world.step_count,
+                                                                  self.world.step_size)))
 
     def _clock_due(self, force):
         """/clock every _clock_every steps and on each step with readings (`force`), counted

@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""rostest: the project's bug-2 controller (nodes/standin_bug2.py, with its go-to-point and
+wall-following nodes) takes m2wr from (0, 8) to the goal round the walls in the way, as
+episodes 8-10 of the series show.
+
+The controller places the robot itself (position-only /gazebo/set_model_state, as the series'
+programs do). The test watches /odom from then on until the robot is within 0.3 m of the goal
+and the controller has logged `goal reached` (or `duration` s of sim time pass), and
+/gazebo/contacts. It prints the nearest distance, the sim time taken, the path length, the
+controller's state changes and the touches; no touch is allowed.
+Parameters (~): goal_x, goal_y [m], duration [s sim], wall_timeout [s wall].
+"""
+import math
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from nav_msgs.msg import Odometry
+
+from pybullet_gazebo.ros.testing import ContactLog, NodeLog, sim_time, wait_for_message
+
+TOLERANCE = 0.3             # [m]
+
+
+class Bug2Test(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_bug2")
+        cls.goal = (rospy.get_param("~goal_x"), rospy.get_param("~goal_y"))
+        cls.duration = rospy.get_param("~duration", 200.0)
+        wall_timeout = rospy.get_param("~wall_timeout", 150.0)
+        cls.lock = threading.Lock()
+        cls.poses = []
+        cls.contacts = ContactLog()
+        cls.log = NodeLog("/bug2")
+        rospy.Subscriber("/odom", Odometry, cls.on_odom, queue_size=100)
+        wait_for_message("/odom", Odometry, timeout=60)
+        cls.log.wait_for(1, timeout=60)                 # "robot placed at (0.00, 8.00)"
+        first = cls.log.since(0.0)[0]
+        cls.placed = first[1].startswith("robot placed at")
+        cls.start = first[0]
+        deadline = time.monotonic() + wall_timeout
+        cls.reached = None
+        while time.monotonic() < deadline and not rospy.is_shutdown():
+            if sim_time() > cls.start + cls.duration:
+                break
+            done = [t for t, text in cls.log.since(cls.start) if text.startswith("goal reached")]
+            if done:
+                cls.reached = done[0]
+                break
+            time.sleep(0.05)
+        cls.end = sim_time()
+
+    @classmethod
+    def on_odom(cls, msg):
+        p = msg.pose.pose.position
+        with cls.lock:
+            cls.poses.append((msg.header.stamp.to_sec(), p.x, p.y))
+
+    def test_reaches_the_goal_without_touching_anything(self):
+        with self.lock:
+            poses = [p for p in self.poses if self.start <= p[0] <= self.end]
+        nearest = min(math.hypot(x - self.goal[0], y - self.goal[1]) for _, x, y in poses)
+        path = sum(math.hypot(b[1] - a[1], b[2] - a[2]) for a, b in zip(poses, poses[1:]))
+        states = [text for t, text in self.log.since(self.start) if text.startswith("state:")]
+        touches = [t for t in self.contacts.touches if self.start <= t[0] <= self.end]
+        summary = ("goal (%.1f, %.1f): nearest %.3f m, %s, path %.1f m, %d state changes, "
+                   "%d touch event(s) %s" % (
+                       self.goal[0], self.goal[1], nearest,
+                       "reached after %.1f s of sim time" % (self.reached - self.start)
+                       if self.reached is not None else "not reached in %.0f s" % self.duration,
+                       path, len(states), len(touches), touches[:3]))
+        rospy.loginfo(summary)
+        print("FIGURES " + summary)
+        self.assertTrue(self.placed, "the controller's set_model_state failed")
+        self.assertIsNotNone(self.reached, summary)
+        self.assertLess(nearest, TOLERANCE)
+        self.assertEqual(touches, [], summary)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("motion_plan", "bug2", Bug2Test)
