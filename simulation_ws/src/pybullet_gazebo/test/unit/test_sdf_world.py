@@ -144,12 +144,12 @@ def test_find_world_accepts_name_file_name_and_path(monkeypatch):
     assert find_world("worlds/poses.world", MY_WORLDS) == fixture_world("poses")
 
 
-@pytest.mark.parametrize("name", ["world03", "", "no/such/file.world", "worlds"])
+@pytest.mark.parametrize("name", ["world04", "", "no/such/file.world", "worlds"])
 def test_find_world_unknown_lists_the_known_worlds(name):
     with pytest.raises(WorldFileError) as error:
         find_world(name, MY_WORLDS)
     assert str(error.value) == (
-        "world '%s' not found; pass world:=NAME with NAME one of world01, world02 (from %s) "
+        "world '%s' not found; pass world:=NAME with NAME one of world01, world02, world03 (from %s) "
         "or a path to a .world file" % (name, MY_WORLDS))
 
 
@@ -356,7 +356,8 @@ EXPECTED_REPORTS = [          # (element as named in the warning, owner)
     ("<sensor>", "model 'robotish'"),
     ("<plugin> in the model", "model 'robotish'"),
     ("<joint> in the model", "model 'robotish'"),
-    ("mesh collisions 'hull' (link 'link'), 'keel' (link 'link')", "model 'meshy_inline'"),
+    ("mesh collisions 'hull' (link 'link', file://hull.stl), 'keel' (link 'link', "
+     "file://keel.stl)", "model 'meshy_inline'"),
 ]
 
 

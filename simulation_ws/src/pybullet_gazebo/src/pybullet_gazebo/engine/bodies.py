@@ -2,14 +2,19 @@
 stand-in can simulate. A link becomes a rigid body in maximal coordinates (world02 steps 15 %
 faster than with multibodies), or a multibody when it holds a plane (pybullet cannot report a
 maximal body's shapes, and the ground checks read the plane back). A static model's bodies
-have no mass.
+have no mass. A triangle mesh goes to Bullet as an OBJ file: a concave triangle mesh on a
+static body, its convex hull on a dynamic one (Bullet collides concave meshes only when
+static); the ray caster gets its triangles (shape_data).
 """
 from dataclasses import dataclass
+import os
+import tempfile
 from typing import List
 
 import pybullet
 
-from .specs import Box, Cylinder, Mesh, ModelSpec, Plane, Sphere
+from . import mesh_files
+from .specs import Box, Cylinder, Mesh, ModelSpec, Plane, Sphere, TriangleMesh
 from .transforms import Pose
 
 
@@ -45,10 +50,12 @@ def _create_link_body(client, model, link, collisions):
                                             planeNormal=collisions[0].geometry.normal)
     else:
         kwargs = dict(shapeTypes=[], radii=[], halfExtents=[], lengths=[], planeNormals=[],
+                      fileNames=[], meshScales=[], flags=[],
                       collisionFramePositions=[], collisionFrameOrientations=[])
-        for collision in collisions:
-            _append_shape(kwargs, collision)
-        shape = client.createCollisionShapeArray(**kwargs)
+        with tempfile.TemporaryDirectory(prefix="pybullet_gazebo_mesh_") as folder:
+            for collision in collisions:
+                _append_shape(kwargs, collision, model.static, folder)
+            shape = client.createCollisionShapeArray(**kwargs)
     world_pose = model.pose.compose(link.pose)
     inertial = link.inertial
     mass = 0.0 if model.static else inertial.mass
@@ -67,10 +74,23 @@ def _create_link_body(client, model, link, collisions):
     return body
 
 
-def _append_shape(kwargs, collision):
-    kind, dimensions = bullet_geometry(collision)
+def _append_shape(kwargs, collision, static, folder):
+    """One shape of createCollisionShapeArray; a triangle mesh as an OBJ file in folder."""
     radius, half, length, normal = 0.0, [0.0, 0.0, 0.0], 0.0, [0.0, 0.0, 1.0]
-    if kind == pybullet.GEOM_BOX:
+    file_name, flags = "", 0
+    if isinstance(collision.geometry, TriangleMesh):
+        kind = pybullet.GEOM_MESH
+        file_name = os.path.join(folder, "%d.obj" % len(kwargs["fileNames"]))
+        mesh_files.write_obj(file_name, collision.geometry.vertices, collision.geometry.faces)
+        flags = pybullet.GEOM_FORCE_CONCAVE_TRIMESH if static else 0
+    else:
+        kind, dimensions = bullet_geometry(collision)
+    kwargs["fileNames"].append(file_name)
+    kwargs["meshScales"].append([1.0, 1.0, 1.0])
+    kwargs["flags"].append(flags)
+    if kind == pybullet.GEOM_MESH:
+        pass
+    elif kind == pybullet.GEOM_BOX:
         half = [s / 2.0 for s in dimensions]
     elif kind == pybullet.GEOM_CYLINDER:
         length, radius = dimensions[0], dimensions[1]
@@ -90,9 +110,13 @@ def _append_shape(kwargs, collision):
 def shape_data(collision, inertial_pose):
     """A collision as pybullet's getCollisionShapeData reports one: (geometry type,
     dimensions, position, orientation), the pose in the link's inertial frame. The caster
-    needs it for the bodies whose shapes pybullet cannot report."""
-    kind, dimensions = bullet_geometry(collision)
+    needs it for the bodies whose shapes pybullet cannot report. A triangle mesh: (GEOM_MESH,
+    its triangles (m, 3, 3) in the collision frame, position, orientation)."""
     local = inertial_pose.inverse().compose(collision.pose)
+    if isinstance(collision.geometry, TriangleMesh):
+        return (pybullet.GEOM_MESH, collision.geometry.triangles(), local.position,
+                local.orientation)
+    kind, dimensions = bullet_geometry(collision)
     return kind, dimensions, local.position, local.orientation
 
 

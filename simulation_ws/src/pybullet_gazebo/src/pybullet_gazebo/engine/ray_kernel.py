@@ -1,8 +1,9 @@
-"""Exact ray-primitive intersections for the ray caster, compiled by numba.
+"""Exact ray-primitive and ray-triangle intersections for the ray caster, compiled by numba.
 
 `nearest_hits` is the inner loop of `raycast.RayCaster.cast`: for every (shape, ray) pair
 that can meet, the exact entry distance into a box (slabs), sphere, cylinder or capsule
-(quadrics). Written as plain loops and compiled to machine code, it does in ~0.05 ms what
+(quadrics). `nearest_mesh_hits` does the same for triangle meshes (Moller-Trumbore on each
+triangle of a mesh whose bounding sphere the ray meets). Written as plain loops and compiled to machine code, it does in ~0.05 ms what
 the same arithmetic spread over numpy array calls did in ~0.4 ms for a 720-beam scan (numpy's
 cost there was the ~100 calls, not the arithmetic).
 
@@ -157,6 +158,71 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
                 out[i] = near
 
 
+@njit(**_JIT)
+def _triangle_hit(ox, oy, oz, dx, dy, dz, t):
+    """Distance along the ray (origin o, unit direction d) to triangle t ((3, 3) corners),
+    either side; inf when it misses (Moller-Trumbore)."""
+    e1x, e1y, e1z = t[1, 0] - t[0, 0], t[1, 1] - t[0, 1], t[1, 2] - t[0, 2]
+    e2x, e2y, e2z = t[2, 0] - t[0, 0], t[2, 1] - t[0, 1], t[2, 2] - t[0, 2]
+    px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
+    det = e1x * px + e1y * py + e1z * pz
+    if abs(det) < 1e-15:                     # the ray runs in the triangle's plane
+        return math.inf
+    inverse = 1.0 / det
+    sx, sy, sz = ox - t[0, 0], oy - t[0, 1], oz - t[0, 2]
+    u = (sx * px + sy * py + sz * pz) * inverse
+    if u < 0.0 or u > 1.0:
+        return math.inf
+    qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
+    v = (dx * qx + dy * qy + dz * qz) * inverse
+    if v < 0.0 or u + v > 1.0:
+        return math.inf
+    return (e2x * qx + e2y * qy + e2z * qz) * inverse
+
+
+@njit(**_JIT)
+def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, bound, start,
+                      count, triangles, body, exclude_body, range_min, range_max, out):
+    """Lowers out[i] to the nearest crossing in [range_min, range_max] of ray i (origin (3,),
+    unit directions (n, 3)) with a triangle of any mesh (position (k, 3), rotation (k, 3, 3),
+    bounding radius about its origin (k,), triangles[start[j]:start[j] + count[j]] in its own
+    frame, body (k,)) whose body is not exclude_body. A mesh is a surface: a triangle is hit
+    from either side. plane_normal as for nearest_hits."""
+    in_plane = plane_normal[0] != 0.0 or plane_normal[1] != 0.0 or plane_normal[2] != 0.0
+    for j in range(position.shape[0]):
+        if body[j] == exclude_body:
+            continue
+        rx = position[j, 0] - origin[0]
+        ry = position[j, 1] - origin[1]
+        rz = position[j, 2] - origin[2]
+        distance2 = rx * rx + ry * ry + rz * rz
+        distance = math.sqrt(distance2)
+        reach = bound[j]
+        if distance - reach > range_max or distance + reach < range_min:
+            continue
+        if in_plane and abs(rx * plane_normal[0] + ry * plane_normal[1]
+                            + rz * plane_normal[2]) > reach:
+            continue
+        r = rotation[j]
+        ox = -(r[0, 0] * rx + r[1, 0] * ry + r[2, 0] * rz)
+        oy = -(r[0, 1] * rx + r[1, 1] * ry + r[2, 1] * rz)
+        oz = -(r[0, 2] * rx + r[1, 2] * ry + r[2, 2] * rz)
+        reach2 = (reach + 1e-9) * (reach + 1e-9)
+        for i in range(directions.shape[0]):
+            dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
+            along = rx * dx + ry * dy + rz * dz
+            if along < range_min - reach or along > range_max + reach \
+                    or distance2 - along * along > reach2:
+                continue
+            lx = r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz
+            ly = r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz
+            lz = r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz
+            for t in range(start[j], start[j] + count[j]):
+                hit = _triangle_hit(ox, oy, oz, lx, ly, lz, triangles[t])
+                if range_min <= hit <= range_max and hit < out[i]:
+                    out[i] = hit
+
+
 def warm_up():
     """Compiles (or loads from numba's cache) nearest_hits with the argument types the
     caster passes; returns the seconds it took."""
@@ -168,4 +234,12 @@ def warm_up():
                  np.eye(3).reshape(1, 3, 3).copy(), np.full((1, 3), 0.5), np.array([0.9]),
                  np.array([7], dtype=np.int64), -1, 0.0, 10.0, out)
     assert out[0] == 1.5 and out[1] == np.inf, out
+    out = np.full(2, np.inf)
+    triangle = np.array([[[0.0, -1.0, -1.0], [0.0, 1.0, -1.0], [0.0, 0.0, 1.0]]])
+    nearest_mesh_hits(np.zeros(3), np.eye(3)[:2].copy(), np.array([0.0, 0.0, 1.0]),
+                      np.array([[2.0, 0.0, 0.0]]), np.eye(3).reshape(1, 3, 3).copy(),
+                      np.array([1.5]), np.array([0], dtype=np.int64),
+                      np.array([1], dtype=np.int64), triangle, np.array([7], dtype=np.int64),
+                      -1, 0.0, 10.0, out)
+    assert out[0] == 2.0 and out[1] == np.inf, out
     return time.perf_counter() - start

@@ -16,9 +16,11 @@ against `client.rayTest`):
   (length, radius, 0) along local z; capsule = (length of the straight part, radius, 0)
   along local z; plane = its normal (x, y, z) through the local origin.
 - Bullet's plane is two-sided: a ray crossing it from either side hits it.
-- Meshes (including URDF cylinders loaded *without* URDF_USE_IMPLICIT_CYLINDER, which Bullet
-  turns into convex hulls) and height fields are not cast against; their (body, link) pairs
-  are listed in `RayCaster.skipped`.
+- Triangle meshes are cast against exactly (ray-triangle, either side of a triangle) when
+  their triangles are handed over in `base_shapes` (the World does so for world models'
+  mesh collisions). Meshes Bullet reports itself (including URDF cylinders loaded *without*
+  URDF_USE_IMPLICIT_CYLINDER, which Bullet turns into convex hulls) and height fields are
+  not cast against; their (body, link) pairs are listed in `RayCaster.skipped`.
 
 Ray semantics (those of Gazebo's ray sensor, whose rays start at the minimum range): a ray
 tests the segment [range_min, range_max] along its direction; hits nearer than range_min are
@@ -36,6 +38,7 @@ _SPHERE, _BOX, _CYLINDER, _CAPSULE = (ray_kernel.SPHERE, ray_kernel.BOX, ray_ker
 _KINDS = {pybullet.GEOM_SPHERE: _SPHERE, pybullet.GEOM_BOX: _BOX,
           pybullet.GEOM_CYLINDER: _CYLINDER, pybullet.GEOM_CAPSULE: _CAPSULE}
 _PLANE = pybullet.GEOM_PLANE
+_MESH = pybullet.GEOM_MESH
 _ONES = np.ones(3)         # row sums as a matrix product, much faster than .sum(axis=1)
 
 
@@ -102,15 +105,72 @@ class _Shapes:
                           for name in _Shapes.FIELDS})
 
 
-class _Body:
-    """What the caster knows of one body: its links with shapes, shapes, planes."""
+class _Meshes:
+    """Triangle meshes as parallel arrays: body id, link row, position (k, 3) and rotation
+    (k, 3, 3) of each mesh's frame, bounding radius (k,) about that origin, and each mesh's
+    triangles as triangles[start:start + count] ((T, 3, 3) corners in the mesh's frame, never
+    moved: rays are turned into the mesh's frame instead)."""
 
-    def __init__(self, body_id, static, links, shapes, planes):
+    FIELDS = ("body", "link_row", "position", "rotation", "bound", "start", "count",
+              "triangles")
+
+    def __init__(self, **arrays):
+        for name in self.FIELDS:
+            setattr(self, name, np.ascontiguousarray(arrays[name]))
+
+    @classmethod
+    def of_body(cls, body, link_row, position, rotation, triangles):
+        """Meshes of one body: triangles is a list of (m_i, 3, 3) arrays."""
+        n = len(triangles)
+        counts = np.array([len(t) for t in triangles], dtype=np.int64)
+        bound = np.array([np.sqrt(np.max(np.sum(t.reshape(-1, 3) ** 2, axis=1)))
+                          for t in triangles])
+        return cls(body=np.full(n, body, dtype=np.int64),
+                   link_row=np.asarray(link_row, dtype=np.int64).reshape(n),
+                   position=np.asarray(position, dtype=float).reshape(n, 3),
+                   rotation=np.asarray(rotation, dtype=float).reshape(n, 3, 3),
+                   bound=bound.reshape(n), start=np.cumsum(counts) - counts, count=counts,
+                   triangles=(np.concatenate(triangles).astype(float) if n
+                              else np.zeros((0, 3, 3))))
+
+    def replace(self, **changes):
+        arrays = {name: getattr(self, name) for name in self.FIELDS}
+        arrays.update(changes)
+        return _Meshes(**arrays)
+
+    def placed(self, link_position, link_rotation):
+        rotation = link_rotation[self.link_row]
+        position = link_position[self.link_row] + np.einsum("nij,nj->ni", rotation,
+                                                            self.position)
+        return self.replace(position=position, rotation=rotation @ self.rotation)
+
+    @staticmethod
+    def concatenate(parts):
+        offsets = np.cumsum([0] + [len(p.triangles) for p in parts[:-1]])
+        arrays = {name: np.concatenate([getattr(p, name) for p in parts])
+                  for name in _Meshes.FIELDS if name != "start"}
+        arrays["start"] = np.concatenate([p.start + o for p, o in zip(parts, offsets)])
+        return _Meshes(**arrays)
+
+
+def _join_parts(parts, kind):
+    """parts (some None) in one kind (_Shapes or _Meshes), or None."""
+    parts = [p for p in parts if p is not None and len(p.body)]
+    if not parts:
+        return None
+    return parts[0] if len(parts) == 1 else kind.concatenate(parts)
+
+
+class _Body:
+    """What the caster knows of one body: its links with shapes, shapes, planes, meshes."""
+
+    def __init__(self, body_id, static, links, shapes, planes, meshes=None):
         self.body_id = body_id
         self.static = static
         self.links = links                    # link indices, -1 = base; rows of link poses
         self.shapes = shapes                  # _Shapes in the links' inertial frames
         self.planes = planes                  # list of (link row, point (3,), normal (3,))
+        self.meshes = meshes                  # _Meshes in the links' inertial frames, or None
 
 
 class _Group:
@@ -119,19 +179,23 @@ class _Group:
 
     def __init__(self, bodies):
         self.bodies = [b for b in bodies if b.links]
-        self.shapes, self.planes, offset = [], [], 0
+        self.shapes, self.planes, meshes, offset = [], [], [], 0
         for body in self.bodies:
             self.shapes.append(body.shapes.replace(link_row=body.shapes.link_row + offset))
             self.planes += [(body.body_id, row + offset, p, n) for row, p, n in body.planes]
+            if body.meshes is not None:
+                meshes.append(body.meshes.replace(link_row=body.meshes.link_row + offset))
             offset += len(body.links)
         self.shapes = _Shapes.concatenate(self.shapes) if self.shapes else None
+        self.meshes = _join_parts(meshes, _Meshes)
         self._last = (None, None)            # (poses read, what place returned for them)
 
     def place(self, client):
-        """(_Shapes or None, [(body, point, normal)]) at the bodies' present poses; the same
-        objects as last time when no body moved (resting bodies sleep and do not)."""
+        """(_Shapes or None, [(body, point, normal)], _Meshes or None) at the bodies' present
+        poses; the same objects as last time when no body moved (resting bodies sleep and do
+        not)."""
         if not self.bodies:
-            return None, []
+            return None, [], None
         positions, orientations = [], []
         for body in self.bodies:
             if body.links[0] == -1:
@@ -150,8 +214,9 @@ class _Group:
         planes = [(body_id, position[row] + rotation[row] @ p, rotation[row] @ n)
                   for body_id, row, p, n in self.planes]
         shapes = self.shapes.placed(position, rotation) if self.shapes is not None else None
-        self._last = ((positions, orientations), (shapes, planes))
-        return shapes, planes
+        meshes = self.meshes.placed(position, rotation) if self.meshes is not None else None
+        self._last = ((positions, orientations), (shapes, planes, meshes))
+        return shapes, planes, meshes
 
 
 class RayCaster:
@@ -173,7 +238,8 @@ class RayCaster:
         `base_shapes` gives the shapes of a body with a base and no links instead, for the
         bodies whose shapes pybullet cannot report (those made with useMaximalCoordinates):
         (geometry type, dimensions, local position, local orientation) each, as
-        getCollisionShapeData reports them."""
+        getCollisionShapeData reports them; a triangle mesh as (GEOM_MESH, its triangles
+        (m, 3, 3) in its own frame, local position, local orientation)."""
         self.remove_body(body_id)
         client = self._client
         if base_shapes is not None:
@@ -185,11 +251,19 @@ class RayCaster:
                                        for e in client.getCollisionShapeData(body_id, link)])
                                for link in range(-1, client.getNumJoints(body_id))]
         kinds, rows, positions, rotations, sizes, planes, links = [], [], [], [], [], [], []
+        mesh_rows, mesh_positions, mesh_rotations, mesh_triangles = [], [], [], []
         for link, entries in shapes_per_link:
             row = len(links)
             used = False
             for geometry, dims, pos, orn in entries:
                 rot = rotation_matrices(orn)[0]
+                if geometry == _MESH and isinstance(dims, np.ndarray) and dims.ndim == 3:
+                    mesh_rows.append(row)                       # triangles from the World
+                    mesh_positions.append(pos)
+                    mesh_rotations.append(rot)
+                    mesh_triangles.append(dims)
+                    used = True
+                    continue
                 if geometry == _PLANE:
                     normal = np.asarray(dims, dtype=float)
                     normal = rot @ (normal / np.linalg.norm(normal))
@@ -215,8 +289,11 @@ class RayCaster:
                 used = True
             if used:
                 links.append(link)
+        meshes = (_Meshes.of_body(body_id, mesh_rows, mesh_positions, mesh_rotations,
+                                  mesh_triangles) if mesh_triangles else None)
         body = _Body(body_id, bool(static), links,
-                     _Shapes.of_body(body_id, kinds, rows, positions, rotations, sizes), planes)
+                     _Shapes.of_body(body_id, kinds, rows, positions, rotations, sizes), planes,
+                     meshes)
         self._bodies[body_id] = body
         if body.static:
             self._static_placed[body_id] = _Group([body]).place(client)
@@ -239,11 +316,14 @@ class RayCaster:
         self._static_cache = None
 
     def _static(self):
-        """All static shapes in one _Shapes (or None) and all static planes."""
+        """All static shapes in one _Shapes (or None), all static planes, all static meshes
+        in one _Meshes (or None)."""
         if self._static_cache is None:
-            shapes = [s for s, _ in self._static_placed.values() if s is not None]
-            planes = [p for _, group_planes in self._static_placed.values() for p in group_planes]
-            self._static_cache = (_Shapes.concatenate(shapes) if shapes else None, planes)
+            placed = list(self._static_placed.values())
+            shapes = [s for s, _, _ in placed if s is not None]
+            planes = [p for _, group_planes, _ in placed for p in group_planes]
+            self._static_cache = (_Shapes.concatenate(shapes) if shapes else None, planes,
+                                  _join_parts([m for _, _, m in placed], _Meshes))
         return self._static_cache
 
     def _dynamic(self, exclude_body):
@@ -272,15 +352,25 @@ class RayCaster:
         if not range_min < range_max or len(directions) == 0:
             return result
 
-        static_shapes, static_planes = self._static()
-        dynamic_shapes, dynamic_planes = self._dynamic(exclude_body)
+        static_shapes, static_planes, static_meshes = self._static()
+        dynamic_shapes, dynamic_planes, dynamic_meshes = self._dynamic(exclude_body)
         for body_id, point, normal in static_planes + dynamic_planes:
             if body_id != exclude_body:
                 np.minimum(result, self._plane_hits(origin, directions, point, normal,
                                                     range_min, range_max), out=result)
         shapes = self._join(static_shapes, dynamic_shapes)
-        if shapes is not None:
+        normal = None
+        if shapes is not None or static_meshes is not None or dynamic_meshes is not None:
             normal = self._coplanar_normal(directions)
+        for meshes in (static_meshes, dynamic_meshes):
+            if meshes is not None:
+                ray_kernel.nearest_mesh_hits(
+                    origin, directions, _NO_PLANE if normal is None else normal,
+                    meshes.position, meshes.rotation, meshes.bound, meshes.start, meshes.count,
+                    meshes.triangles, meshes.body,
+                    -1 if exclude_body is None else int(exclude_body), range_min, range_max,
+                    result)
+        if shapes is not None:
             ray_kernel.nearest_hits(origin, directions, _NO_PLANE if normal is None else normal,
                                     shapes.kind, shapes.position, shapes.rotation, shapes.size,
                                     shapes.bound, shapes.body,

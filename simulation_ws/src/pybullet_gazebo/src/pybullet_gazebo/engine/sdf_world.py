@@ -25,13 +25,22 @@ spec keeps model poses in the world frame, link poses in the model frame, collis
 inertial poses in the link frame, so a collision's world pose is
 `model.pose.compose(link.pose).compose(collision.pose)`.
 
-Mesh collisions and their primitive replacement
-A model directory may hold `pybullet_collision.sdf` beside its model.sdf: an ordinary
-`<sdf><model><link name=L><collision>...` file whose collisions (primitives, poses in L's
-frame) replace *all mesh collisions* of the model's link L; L's primitive collisions are kept.
-This lets a foreign model (e.g. Gazebo's own jersey_barrier, whose collision is a mesh) be used
-unchanged. A mesh with no replacement stays a `Mesh` in the spec (the World builder skips it)
-and the model gets one warning naming its mesh collisions. Our own models use primitives only.
+Mesh collisions, in this order
+1. A model directory may hold `pybullet_collision.sdf` beside its model.sdf: an ordinary
+   `<sdf><model><link name=L><collision>...` file whose collisions (primitives, poses in L's
+   frame) replace *all mesh collisions* of the model's link L; L's primitive collisions are
+   kept (an explicit choice of the model's author, so it wins).
+2. A mesh whose file resolves (mesh_files: model://, file://, package://, a path) and reads
+   (.obj, .stl, .dae) becomes a `TriangleMesh` (its triangles, scaled by `<scale>`): the World
+   gives Bullet a concave triangle mesh for a static model, a convex hull for a dynamic one,
+   and the ray caster tests the triangles exactly.
+3. A `model://NAME/...` mesh whose file is missing, when the model path holds a model NAME
+   made of primitives only (the project ships construction_barrel, jersey_barrier, coke_can):
+   NAME's primitive collisions stand in, scaled by the mesh's `<scale>` and placed at the
+   mesh collision's pose; the model gets a warning saying so. This is the series' world03,
+   whose barrels are inline models with a model://construction_barrel mesh as collision.
+4. Anything else stays a `Mesh` in the spec (the World builder leaves it out) and the model
+   gets one warning naming its mesh collisions and their URIs.
 
 What is ignored, and what is reported
 - Silently ignored: purely visual or rendering elements (`visual`, `light`, `scene`, `gui`,
@@ -53,8 +62,9 @@ import os
 import xml.etree.ElementTree as ET
 from dataclasses import replace
 
+from . import mesh_files
 from .specs import (Box, CollisionSpec, Cylinder, InertialSpec, LinkSpec, Mesh, ModelSpec,
-                    PhysicsSpec, Plane, Sphere, WorldSpec)
+                    PhysicsSpec, Plane, Sphere, TriangleMesh, WorldSpec)
 from .transforms import Pose
 
 REPLACEMENT_FILE = "pybullet_collision.sdf"
@@ -146,6 +156,19 @@ def _all_zero(text):
         return False
 
 
+def _scaled(geometry, scale):
+    """A primitive geometry stretched by a mesh's <scale> (sx, sy, sz): a cylinder (along z)
+    takes the larger of sx, sy for its radius, a sphere the largest of the three."""
+    sx, sy, sz = scale
+    if isinstance(geometry, Box):
+        return Box(tuple(v * k for v, k in zip(geometry.size, scale)))
+    if isinstance(geometry, Cylinder):
+        return Cylinder(radius=geometry.radius * max(sx, sy), length=geometry.length * sz)
+    if isinstance(geometry, Sphere):
+        return Sphere(radius=geometry.radius * max(scale))
+    return geometry
+
+
 def _carries_value(elem):
     """True when the element or a descendant has text or a non-empty attribute."""
     for node in elem.iter():
@@ -161,6 +184,7 @@ class _WorldReader:
         self.files = [self.path]            # the file being read now is files[-1]
         self.warnings = []
         self._warned = set()
+        self._stand_ins = {}                # model name -> its primitive collisions, or None
 
     # --- reporting ------------------------------------------------------------------------
     def error(self, message):
@@ -421,27 +445,78 @@ class _WorldReader:
                 normal=normal,
                 size=tuple(self.numbers(_text(shape, "size", "1 1"), 2, owner, "size")))
         if tag == "mesh":
-            uri = _text(shape, "uri", "")
-            return Mesh(uri=self.resolve_uri(uri),
-                        scale=tuple(self.numbers(_text(shape, "scale", "1 1 1"), 3, owner,
-                                                 "scale")))
+            return self.mesh(shape, owner, where)
         self.warn(owner, tag, "<%s> geometry of %s is not supported; the collision is "
                   "left out" % (tag, where))
         return None
 
-    def resolve_uri(self, uri):
-        """model://NAME/rest as an absolute file path when found in the model path."""
-        if uri.startswith("model://"):
-            rest = uri[len("model://"):]
-            for directory in self.model_path:
-                candidate = os.path.join(directory, rest)
-                if os.path.isfile(candidate):
-                    return os.path.abspath(candidate)
-        return uri
+    def mesh(self, shape, owner, where):
+        """A TriangleMesh when the file resolves and reads, else a Mesh (see replace_meshes)."""
+        uri = _text(shape, "uri", "")
+        scale = tuple(self.numbers(_text(shape, "scale", "1 1 1"), 3, owner, "scale"))
+        path = mesh_files.resolve(uri, self.model_path, os.path.dirname(self.files[-1]))
+        if path is not None and not mesh_files.readable(path):
+            self.warn(owner, "mesh format " + uri, "mesh %s of %s: the stand-in reads %s files "
+                      "only; convert it to one of them" % (
+                          uri, where, ", ".join(mesh_files.FORMATS)))
+        elif path is not None:
+            try:
+                vertices, faces = mesh_files.load_triangles(path, scale)
+                return TriangleMesh(uri=uri, path=path, vertices=vertices, faces=faces)
+            except mesh_files.MeshFileError as error:
+                self.warn(owner, "mesh file " + uri, "%s (mesh of %s); fix or replace the file"
+                          % (error, where))
+        return Mesh(uri=uri, scale=scale)
+
+    def stand_in(self, name):
+        """The collisions (in the stand-in's model frame) of model NAME from the model path
+        when all of them are primitives, else None. Read once per name."""
+        if name not in self._stand_ins:
+            collisions = None
+            try:
+                model_dir = self.find_model(name)
+            except WorldFileError:
+                model_dir = None
+            if model_dir is not None:
+                sdf_path = self.model_sdf_file(model_dir)
+                self.files.append(sdf_path)
+                root = _read_xml(sdf_path, "model file of model://%s" % name)
+                model_elem = root.find("model") if root.tag == "sdf" else None
+                model = (self.model(model_elem, model_dir, check_meshes=False)
+                         if model_elem is not None else None)
+                self.files.pop()
+                if model is not None:
+                    collisions = [replace(c, pose=link.pose.compose(c.pose))
+                                  for link in model.links for c in link.collisions]
+                    if not collisions or any(isinstance(c.geometry, (Mesh, TriangleMesh))
+                                             for c in collisions):
+                        collisions = None
+            self._stand_ins[name] = collisions
+        return self._stand_ins[name]
+
+    def stand_in_for(self, collision):
+        """Collisions replacing a mesh collision whose file is missing, from the primitive
+        model its model://NAME URI names, scaled by the mesh's <scale> and placed at the
+        mesh's pose; None when there is no such model."""
+        name = mesh_files.model_name(collision.geometry.uri)
+        primitives = self.stand_in(name) if name else None
+        if primitives is None:
+            return None
+        scale = collision.geometry.scale
+        return [replace(c, name="%s::%s" % (collision.name, c.name),
+                        geometry=_scaled(c.geometry, scale),
+                        pose=collision.pose.compose(Pose(
+                            tuple(p * k for p, k in zip(c.pose.position, scale)),
+                            c.pose.orientation)),
+                        mu=collision.mu, mu2=collision.mu2)
+                for c in primitives]
 
     def replace_meshes(self, links, model_dir, owner):
-        """Links with mesh collisions replaced from REPLACEMENT_FILE where it names them."""
-        if not any(isinstance(c.geometry, Mesh) for link in links for c in link.collisions):
+        """Links with mesh collisions replaced from REPLACEMENT_FILE where it names them;
+        then each mesh whose file is missing by the primitives of the model its URI names
+        (stand_in_for); what is left is reported."""
+        if not any(isinstance(c.geometry, (Mesh, TriangleMesh))
+                   for link in links for c in link.collisions):
             return links
         replacements = {}
         path = os.path.join(model_dir, REPLACEMENT_FILE) if model_dir else None
@@ -457,16 +532,32 @@ class _WorldReader:
             self.files.pop()
         result, meshes = [], []
         for link in links:
-            has_mesh = any(isinstance(c.geometry, Mesh) for c in link.collisions)
+            has_mesh = any(isinstance(c.geometry, (Mesh, TriangleMesh)) for c in link.collisions)
             if has_mesh and link.name in replacements:
-                kept = [c for c in link.collisions if not isinstance(c.geometry, Mesh)]
+                kept = [c for c in link.collisions
+                        if not isinstance(c.geometry, (Mesh, TriangleMesh))]
                 link = replace(link, collisions=tuple(kept + replacements[link.name]))
-            meshes.extend("'%s' (link '%s')" % (c.name, link.name) for c in link.collisions
-                          if isinstance(c.geometry, Mesh))
+            collisions = []
+            for c in link.collisions:
+                stand_in = self.stand_in_for(c) if isinstance(c.geometry, Mesh) else None
+                if stand_in is not None:
+                    self.warn(owner, "stand-in " + c.geometry.uri, "mesh %s of collision '%s' "
+                              "(link '%s') is not in the model path; the primitive collisions "
+                              "of model://%s are used instead, scaled by %s" % (
+                                  c.geometry.uri, c.name, link.name,
+                                  mesh_files.model_name(c.geometry.uri),
+                                  " ".join("%g" % k for k in c.geometry.scale)))
+                    collisions.extend(stand_in)
+                else:
+                    collisions.append(c)
+            link = replace(link, collisions=tuple(collisions))
+            meshes.extend("'%s' (link '%s', %s)" % (c.name, link.name, c.geometry.uri)
+                          for c in link.collisions if isinstance(c.geometry, Mesh))
             result.append(link)
         if meshes:
-            self.warn(owner, "mesh", "mesh collision%s %s: no primitive replacement, so the "
-                      "World builder leaves %s out; add primitive collisions in %s" % (
+            self.warn(owner, "mesh", "mesh collision%s %s: file not found or not readable and "
+                      "no primitive replacement, so the World builder leaves %s out; add "
+                      "primitive collisions in %s" % (
                           "s" if len(meshes) > 1 else "", ", ".join(meshes),
                           "them" if len(meshes) > 1 else "it",
                           os.path.join(model_dir, REPLACEMENT_FILE) if model_dir

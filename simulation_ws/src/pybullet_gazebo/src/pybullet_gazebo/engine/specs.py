@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 from typing import Dict, Optional, Tuple
 import xml.etree.ElementTree as ET
 
+import numpy as np
+
 from .transforms import Pose
 
 
@@ -34,14 +36,28 @@ class Plane:
 
 @dataclass(frozen=True)
 class Mesh:
+    """A mesh collision whose file could not be found or read: the World leaves it out."""
     uri: str
     scale: Tuple[float, float, float] = (1.0, 1.0, 1.0)
 
 
 @dataclass(frozen=True)
+class TriangleMesh:
+    """A mesh collision read from its file: triangles in the collision frame, scaled."""
+    uri: str
+    path: str                                 # the file read
+    vertices: np.ndarray = field(compare=False, repr=False)   # (n, 3) [m]
+    faces: np.ndarray = field(compare=False, repr=False)      # (m, 3) vertex indices
+
+    def triangles(self):
+        """(m, 3, 3) corners of each triangle [m]."""
+        return self.vertices[self.faces]
+
+
+@dataclass(frozen=True)
 class CollisionSpec:
     name: str
-    geometry: object                          # Box | Cylinder | Sphere | Plane | Mesh
+    geometry: object                          # Box | Cylinder | Sphere | Plane | TriangleMesh | Mesh
     pose: Pose = Pose()                       # in the link frame
     mu: float = 1.0                           # Gazebo's (ODE) default friction
     mu2: float = 1.0
