@@ -51,6 +51,11 @@ class Bug2Test(unittest.TestCase):
                 cls.reached = done[0]
                 break
             time.sleep(0.05)
+        if cls.reached is not None:          # the /odom the controller saw may still be queued
+            settle = time.monotonic() + 5.0
+            while time.monotonic() < settle and not any(
+                    t >= cls.reached for t, _, _ in list(cls.poses)):
+                time.sleep(0.05)
         cls.end = sim_time()
 
     @classmethod

@@ -149,8 +149,6 @@ class SimulatorNode:
                 continue
             self.lockstep.wait_if_due(self.world.sim_time, self._commands_heard)
             with self.lock:
-                if rospy.is_shutdown():      # shutdown() may have disconnected Bullet
-                    break
                 readings = self.world.step()
                 commands_before = self.lockstep.commands
                 now = self.world.sim_time
@@ -235,7 +233,6 @@ class SimulatorNode:
 
     def _disconnect(self):
         try:
-            with self.lock:             # not in the middle of a step (rospy calls this from
-                self.client.disconnect()    # its signal handling thread)
+            self.client.disconnect()
         except pybullet.error:
             pass
