@@ -10,10 +10,12 @@ Parameters (read before init_node):
               -1: the twin for the simulator's default (Gazebo Noetic's turning of m2wr)
   wall_follower_active  start active (false: wait for the switch), as a convenience for tests
 Topics: /m2wr/laser/scan (sensor_msgs/LaserScan) in; /cmd_vel (geometry_msgs/Twist) out at
-20 Hz sim while active. Service: /wall_follower_switch (std_srvs/SetBool).
+20 Hz sim while active. Service: /wall_follower_switch (std_srvs/SetBool); switched off, it
+publishes one zero Twist (the drive holds the last command, as Gazebo's does).
 Logs each change of state (`state: follow the wall`, ...).
 """
 import math
+import threading
 
 import rospy
 from geometry_msgs.msg import Twist
@@ -57,6 +59,7 @@ class WallFollower:
     def __init__(self, turn_sign, active):
         self.turn_sign = turn_sign
         self.active = active
+        self.switching = threading.Lock()    # a command never goes out after the stop
         self.state = None
         self.region = None
         self.wall_seen_at = -float("inf")    # [s] ROS time the wall was last beside it
@@ -65,7 +68,13 @@ class WallFollower:
         rospy.Service("/wall_follower_switch", SetBool, self.on_switch)
 
     def on_switch(self, request):
+        with self.switching:
+            return self.switch(request)
+
+    def switch(self, request):
         self.active = request.data
+        if not self.active:
+            self.cmd_vel.publish(Twist())    # stop: the drive would hold the last command
         rospy.loginfo("wall follower %s", "on" if self.active else "off")
         return SetBoolResponse(True, "done")
 
@@ -75,19 +84,25 @@ class WallFollower:
     def spin(self):
         rate = rospy.Rate(RATE)
         while not rospy.is_shutdown():
-            if self.active and self.region is not None:
-                now = rospy.get_time()
-                state, linear, angular = decide(self.region, now - self.wall_seen_at)
-                if state != FIND:
-                    self.wall_seen_at = now
-                if state != self.state:
-                    rospy.loginfo("state: %s", state)
-                    self.state = state
-                twist = Twist()
-                twist.linear.x = linear
-                twist.angular.z = angular * self.turn_sign
-                self.cmd_vel.publish(twist)
+            with self.switching:
+                self.tick()
             rate.sleep()
+
+    def tick(self):
+        """Publishes the command for the present regions, while active."""
+        if not self.active or self.region is None:
+            return
+        now = rospy.get_time()
+        state, linear, angular = decide(self.region, now - self.wall_seen_at)
+        if state != FIND:
+            self.wall_seen_at = now
+        if state != self.state:
+            rospy.loginfo("state: %s", state)
+            self.state = state
+        twist = Twist()
+        twist.linear.x = linear
+        twist.angular.z = angular * self.turn_sign
+        self.cmd_vel.publish(twist)
 
 
 def main():

@@ -10,16 +10,23 @@ Parameters (read before init_node, global names as in the series):
                         run with legacy_mode:=true, or Gazebo Kinetic); -1: the twin for the
                         simulator's default (Gazebo Noetic), under which a positive angular.z
                         turns m2wr clockwise
-Topics: /odom (nav_msgs/Odometry) in; /cmd_vel (geometry_msgs/Twist) out at 20 Hz sim, only
+Unlike the series' program it also stops driving forward when the laser's front fifth sees
+something nearer than 0.45 m: a bug controller that switches it off when it meets an
+obstacle does so by a service call, which a simulator running many times faster than real
+time does not wait for; without the stop the robot would drive on into the wall meanwhile.
+Topics: /odom (nav_msgs/Odometry) and /m2wr/laser/scan (sensor_msgs/LaserScan) in; /cmd_vel (geometry_msgs/Twist) out at 20 Hz sim, only
 while active. Service: /go_to_point_switch (std_srvs/SetBool): data true starts (reading
-des_pos_x/des_pos_y again, so a new goal can be given without a restart), false stops.
+des_pos_x/des_pos_y again, so a new goal can be given without a restart), false stops (and
+publishes one zero Twist: the drive holds the last command, as Gazebo's does).
 Logs `goal reached` once within 0.3 m of the goal.
 """
 import math
+import threading
 
 import rospy
 from geometry_msgs.msg import Point, Twist
 from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
 from std_srvs.srv import SetBool, SetBoolResponse
 from tf import transformations
 
@@ -28,6 +35,7 @@ DRIVE_SPEED = 0.6           # [m/s]
 HEADING_TOLERANCE = math.radians(2.0)   # [rad] turn until the heading error is under this
 HEADING_DRIFT = math.radians(15.0)      # [rad] driving: turn in place again beyond this
 GOAL_TOLERANCE = 0.3        # [m]
+SAFETY_STOP = 0.45          # [m] nothing drives forward with the front nearer than this
 RATE = 20.0                 # [Hz] of ROS time
 
 FIX_HEADING, DRIVE, DONE = "fix heading", "drive", "done"
@@ -44,20 +52,29 @@ class GoToPoint:
         self.goal = goal
         self.turn_sign = turn_sign
         self.active = False
+        self.switching = threading.Lock()    # a command never goes out after the stop
         self.state = FIX_HEADING
         self.position = None
         self.yaw = 0.0
+        self.front = float("inf")           # [m] nearest range of the scan's middle fifth
         self.cmd_vel = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
         rospy.Subscriber("/odom", Odometry, self.on_odom, queue_size=1)
+        rospy.Subscriber("/m2wr/laser/scan", LaserScan, self.on_scan, queue_size=1)
         rospy.Service("/go_to_point_switch", SetBool, self.on_switch)
 
     def on_switch(self, request):
+        with self.switching:
+            return self.switch(request)
+
+    def switch(self, request):
         self.active = request.data
         if self.active:
             self.state = FIX_HEADING
             # the goal may have changed since the start (the series reads it once)
             self.goal = Point(rospy.get_param("des_pos_x", self.goal.x),
                               rospy.get_param("des_pos_y", self.goal.y), 0.0)
+        else:
+            self.cmd_vel.publish(Twist())    # stop: the drive would hold the last command
         rospy.loginfo("go to point %s", ("on: goal (%.2f, %.2f)" % (self.goal.x, self.goal.y))
                       if self.active else "off")
         return SetBoolResponse(True, "done")
@@ -66,6 +83,11 @@ class GoToPoint:
         self.position = msg.pose.pose.position
         q = msg.pose.pose.orientation
         self.yaw = transformations.euler_from_quaternion([q.x, q.y, q.z, q.w])[2]
+
+    def on_scan(self, msg):
+        fifth = len(msg.ranges) // 5
+        middle = [r for r in msg.ranges[2 * fifth:3 * fifth] if r == r]
+        self.front = min(middle) if middle else float("inf")
 
     def command(self):
         """The Twist for now (REP 103 signs before turn_sign) and the next state."""
@@ -90,17 +112,18 @@ class GoToPoint:
         if abs(error) > HEADING_DRIFT:
             self.state = FIX_HEADING
             return twist
-        twist.linear.x = DRIVE_SPEED
+        twist.linear.x = DRIVE_SPEED if self.front > SAFETY_STOP else 0.0
         twist.angular.z = max(-0.3, min(0.3, 1.5 * error))       # small steering while driving
         return twist
 
     def spin(self):
         rate = rospy.Rate(RATE)
         while not rospy.is_shutdown():
-            if self.active:
-                twist = self.command()
-                twist.angular.z *= self.turn_sign
-                self.cmd_vel.publish(twist)
+            with self.switching:
+                if self.active:
+                    twist = self.command()
+                    twist.angular.z *= self.turn_sign
+                    self.cmd_vel.publish(twist)
             rate.sleep()
 
 
