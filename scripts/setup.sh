@@ -31,6 +31,8 @@ APT_PACKAGES=(
   # what programs written for Gazebo import or run beside it: tf (the series' later
   # programs: `from tf import transformations`), joint_state_publisher, tf2_tools (view_frames)
   python3-tf joint-state-publisher tf2-tools
+  # gazebo_msgs' SetJointTrajectory; Gazebo's physics dynamic_reconfigure server
+  ros-trajectory-msgs libtrajectory-msgs-dev python3-trajectory-msgs python3-dynamic-reconfigure
 )
 
 STEP="check machine"

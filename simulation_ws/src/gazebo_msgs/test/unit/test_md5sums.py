@@ -1,22 +1,44 @@
 """Our gazebo_msgs must be wire-compatible with ROS Noetic's: a client built against Gazebo's
-gazebo_msgs only talks to a service whose md5sum matches. Figures from
-shared/reference/m2wr_and_gazebo.md (md5sums of gazebo_msgs as shipped for Noetic)."""
+gazebo_msgs only talks to a topic or service whose md5sum matches. noetic_md5sums.txt holds
+the md5sum of every message and service of Noetic's gazebo_msgs (computed once with genmsg
+from gazebo_ros_pkgs' noetic-devel definitions); every type must be here and match."""
+import importlib
+import os
+
 import pytest
 
-from gazebo_msgs import msg, srv
-
-NOETIC_MD5SUMS = {
-    srv.SpawnModel: "9ed9c82c96abe1a00c3e8cdaeee24413",
-    srv.DeleteModel: "9ce56b4e9e54616de25d796dc972a262",
-    srv.GetModelState: "4c515e936d3319c9610c559c60bfc3d4",
-    srv.SetModelState: "5b3ab0281d4f5445def017e3a2e4a07b",
-    srv.GetWorldProperties: "36bb0f2eccf4d8be971410c22818ba3f",
-    srv.GetPhysicsProperties: "575a5e74786981b7df2e3afc567693a6",
-    msg.ModelState: "9330fd35f2fcd82d457e54bd54e10593",
-    msg.ModelStates: "48c080191eb15c41858319b4d8a609c2",
-}
+HERE = os.path.dirname(os.path.abspath(__file__))
+PACKAGE = os.path.dirname(os.path.dirname(HERE))
 
 
-@pytest.mark.parametrize("kind", list(NOETIC_MD5SUMS), ids=lambda k: k._type)
+def noetic_md5sums():
+    table = {}
+    with open(os.path.join(HERE, "noetic_md5sums.txt")) as source:
+        for line in source:
+            if line.strip() and not line.startswith("#"):
+                kind, md5sum = line.split()
+                table[kind] = md5sum
+    return table
+
+
+NOETIC = noetic_md5sums()
+
+
+def test_the_table_lists_every_type_of_noetic_gazebo_msgs():
+    assert len(NOETIC) == 34          # 11 messages, 23 services
+    assert sum(k.startswith("msg/") for k in NOETIC) == 11
+
+
+def test_the_package_defines_exactly_noetic_types():
+    ours = {"%s/%s" % (folder, name.rsplit(".", 1)[0])
+            for folder in ("msg", "srv") for name in os.listdir(os.path.join(PACKAGE, folder))}
+    assert ours == set(NOETIC)
+
+
+@pytest.mark.parametrize("kind", sorted(NOETIC))
 def test_md5sum_matches_noetic(kind):
-    assert kind._md5sum == NOETIC_MD5SUMS[kind]
+    folder, name = kind.split("/")
+    module = importlib.import_module("gazebo_msgs.%s" % folder)
+    generated = getattr(module, name)
+    assert generated._md5sum == NOETIC[kind]
+    assert generated._type == "gazebo_msgs/" + name
