@@ -117,13 +117,17 @@ def test_duplicate_name_fails_and_leaves_the_first_alone(make_world, m2wr_urdf):
     assert world.model_names().count("m2wr") == 1
 
 
-def test_spawn_inside_an_obstacle_fails_and_leaves_no_body(make_world, m2wr_urdf):
+def test_spawn_inside_an_obstacle_is_spawned_with_a_warning_naming_both(make_world, m2wr_urdf):
+    """Gazebo spawns a model that overlaps another; so does the stand-in, and says so."""
     world = make_world("world02")
     bodies = world.client.getNumBodies()
-    with pytest.raises(SpawnError, match="inside jersey_barrier"):
-        world.spawn_urdf("stuck", m2wr_urdf, Pose.from_xyz_rpy(-0.94, 4.73, 0.2))
-    assert world.client.getNumBodies() == bodies
-    assert "stuck" not in world.model_names()
+    world.spawn_urdf("stuck", m2wr_urdf, Pose.from_xyz_rpy(-0.94, 4.73, 0.2))
+    assert world.client.getNumBodies() == bodies + 1
+    assert "stuck" in world.model_names()
+    assert any("'stuck' inside 'jersey_barrier" in w and "spawned anyway" in w
+               for w in world.warnings)
+    run(world, 0.5)
+    assert all(math.isfinite(v) for v in world.model_pose("stuck").position)
 
 
 @pytest.mark.parametrize("text, message", [

@@ -14,7 +14,7 @@ from typing import List
 import pybullet
 
 from . import mesh_files
-from .specs import Box, Cylinder, Mesh, ModelSpec, Plane, Sphere, TriangleMesh
+from .specs import Box, Cylinder, LinkSpec, Mesh, ModelSpec, Plane, Sphere, TriangleMesh
 from .transforms import Pose
 
 
@@ -26,12 +26,13 @@ class ModelBodies:
     inertial_offsets: List[Pose]    # each body's inertial frame in its link frame
     shapes: List[list]              # per body: shape_data() of each collision
     is_ground: bool                 # every collision is a plane
+    links: List[LinkSpec]           # the link each body stands for
 
 
 def build_model(client, model: ModelSpec) -> ModelBodies:
     """Creates the model's bodies at its pose; an empty body list when no collision of it can
     be simulated (meshes are reported by the world reader)."""
-    built = ModelBodies([], [], [], [], True)
+    built = ModelBodies([], [], [], [], True, [])
     for link in model.links:
         collisions = [c for c in link.collisions if not isinstance(c.geometry, Mesh)]
         if not collisions:
@@ -40,6 +41,7 @@ def build_model(client, model: ModelSpec) -> ModelBodies:
         built.body_ids.append(_create_link_body(client, model, link, collisions))
         built.link_offsets.append(link.pose)
         built.inertial_offsets.append(link.inertial.pose)
+        built.links.append(link)
         built.shapes.append([shape_data(c, link.inertial.pose) for c in collisions])
     return built
 

@@ -33,6 +33,10 @@ class Entity:
     # a world model's collision shapes per body, as getCollisionShapeData reports them
     # (which pybullet cannot do for maximal bodies): see bodies.shape_data. Empty for a robot.
     shapes: List[list] = field(default_factory=list)
+    # Gazebo's link names, one per body (a robot: its root link), and a world model's
+    # LinkSpecs (see model_access)
+    link_names: List[str] = field(default_factory=list)
+    link_specs: list = field(default_factory=list)
 
 
 @dataclass(frozen=True)

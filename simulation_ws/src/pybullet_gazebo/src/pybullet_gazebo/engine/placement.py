@@ -16,10 +16,12 @@ MAX_VELOCITY = 1.0e6            # [m/s] and [rad/s] per axis, for a set_model_st
 
 
 def checked_pose(pose: Pose, what: str, advice: str, error=ValueError,
-                 linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)) -> Pose:
+                 linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0),
+                 zero_is_identity=False) -> Pose:
     """The pose with its quaternion normalised, or `error` naming `what` (e.g. "spawn pose
     of 'm2wr'") and `advice` when a value is not finite, a position is beyond MAX_COORDINATE,
-    a velocity beyond MAX_VELOCITY or the quaternion is zero."""
+    a velocity beyond MAX_VELOCITY or the quaternion is zero. `zero_is_identity`: an all-zero
+    quaternion is the identity instead (Gazebo's set_model_state normalizes it so)."""
     values = list(pose.position) + list(pose.orientation) + list(linear) + list(angular)
     if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
         raise error("%s is not finite (a non-finite value in %s); %s"
@@ -31,6 +33,8 @@ def checked_pose(pose: Pose, what: str, advice: str, error=ValueError,
         raise error("%s: twist (linear %s, angular %s) is over %g m/s or rad/s; %s"
                     % (what, tuple(linear), tuple(angular), MAX_VELOCITY, advice))
     norm = math.sqrt(sum(q * q for q in pose.orientation))
+    if zero_is_identity and all(q == 0.0 for q in pose.orientation):
+        return Pose(pose.position, (0.0, 0.0, 0.0, 1.0))
     if norm < 1e-9:          # Bullet would keep it and the robot's sensors would see NaN
         raise error("%s: orientation %s is a zero quaternion; %s"
                     % (what, tuple(pose.orientation), advice))

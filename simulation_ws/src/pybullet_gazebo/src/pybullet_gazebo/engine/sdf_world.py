@@ -126,6 +126,35 @@ def load_world(path, model_path):
     return _WorldReader(path, model_path).read()
 
 
+def load_model_text(text, model_path=()):
+    """(ModelSpec, warnings) of the model in an SDF text, as spawn_sdf_model receives it:
+    `<sdf><model>` or `<sdf><include>` (Gazebo also takes a `<gazebo>` root). The model's pose
+    and name are its own; the caller replaces them. ValueError, naming what is wrong, for text
+    that is not such a model."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as error:
+        line, column = error.position
+        raise ValueError("model_xml is malformed XML at line %d, column %d (%s); send an "
+                         "<sdf><model> document" % (line, column, str(error).rsplit(": line", 1)[0]))
+    if root.tag not in ("sdf", "gazebo"):
+        raise ValueError("model_xml's root element is <%s>; an SDF model is <sdf version='1.6'>"
+                         "<model name='...'>..." % root.tag)
+    reader = _WorldReader("<spawn_sdf_model request>", model_path)
+    elem = root.find("model")
+    try:
+        if elem is not None:
+            model = reader.model(elem)
+        elif root.find("include") is not None:
+            model = reader.include(root.find("include"), "spawn request")
+        else:
+            raise ValueError("model_xml has no <model> (nor <include>) under <%s>; the stand-in "
+                             "spawns models (lights and actors are not simulated)" % root.tag)
+    except WorldFileError as error:
+        raise ValueError(str(error).replace("<spawn_sdf_model request>: ", ""))
+    return model, tuple(reader.warnings)
+
+
 def _read_xml(path, what):
     try:
         return ET.parse(path).getroot()

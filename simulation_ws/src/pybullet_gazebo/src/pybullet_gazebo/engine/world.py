@@ -10,9 +10,11 @@ Bullet multibody whose model frame is its root link's frame. Bullet reports a bo
 3.2 reports garbage for a maximal body's inertial frame).
 """
 import math
+from dataclasses import replace
 from typing import Callable, Dict, List, Optional
 
 import numpy as np
+import pybullet
 
 from . import wheel_contact
 from .bodies import build_model
@@ -22,8 +24,10 @@ from .placement import checked_pose, grounds_above, overlapping
 from .raycast import RayCaster
 from .robot_description import parse_robot
 from .robot_loader import SpawnError, load_body, make_robot
+from .sdf_world import load_model_text
 from .specs import WorldSpec
 from .transforms import Pose
+from .wrenches import WrenchSchedule
 
 __all__ = ["World", "SpawnError", "ModelNotFound", "Robot", "Entity", "Reading"]
 
@@ -61,6 +65,11 @@ class World:
         self._stepped = ([], [])                    # cache: (robot, part) pairs, (name, body)
         self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
+        self.gravity = tuple(spec.physics.gravity)   # [m/s^2]
+        self.wrenches = WrenchSchedule(client, self.gravity)   # apply_body_wrench & co.
+        self.layout_version = 0     # counts teleports and deletions (caches of static poses)
+        self._time_before = 0.0     # [s] sim time before the step size last changed ...
+        self._steps_before = 0      # ... and the step count then
 
         client.resetSimulation()
         client.setGravity(*spec.physics.gravity)
@@ -75,7 +84,36 @@ class World:
     # --- time ---------------------------------------------------------------------------
     @property
     def sim_time(self) -> float:
-        return self.step_count * self.step_size
+        return self._time_before + (self.step_count - self._steps_before) * self.step_size
+
+    def sim_time_ns(self) -> int:
+        """Sim time in integer nanoseconds: exact, never drifts over millions of steps."""
+        return int(round(self._time_before * 1e9)) + \
+            (self.step_count - self._steps_before) * int(round(self.step_size * 1e9))
+
+    def set_step_size(self, step_size):
+        """A new fixed physics step [s] from the next step on; sim time runs on from where it
+        is (Gazebo's set_physics_properties time_step)."""
+        if not (isinstance(step_size, (int, float)) and math.isfinite(step_size)
+                and 0.0 < step_size <= 1.0):
+            raise ValueError("time_step %r must be a number of seconds in (0, 1]" % (step_size,))
+        self._time_before = self.sim_time
+        self._steps_before = self.step_count
+        self.step_size = float(step_size)
+        self.client.setPhysicsEngineParameter(fixedTimeStep=self.step_size)
+
+    def set_gravity(self, gravity):
+        """Gravity [m/s^2], world frame, from the next step on."""
+        if len(gravity) != 3 or not all(math.isfinite(g) for g in gravity):
+            raise ValueError("gravity %s must be three finite numbers [m/s^2]" % (tuple(gravity),))
+        self.gravity = tuple(float(g) for g in gravity)
+        self.wrenches.gravity = np.asarray(self.gravity)
+        self.client.setGravity(*self.gravity)
+        for entity in self.entities.values():     # sleeping bodies would not feel the change
+            if not entity.static:
+                for body in entity.body_ids:
+                    self.client.changeDynamics(
+                        body, -1, activationState=pybullet.ACTIVATION_STATE_WAKE_UP)
 
     def step(self) -> List[Reading]:
         """Advances physics by one fixed step; returns the parts' readings now due."""
@@ -84,6 +122,7 @@ class World:
         parts, bodies = self._stepped
         for _, part in parts:
             part.before_step(now, self.step_size)
+        self.wrenches.apply(now)
         self.client.stepSimulation()
         self.step_count += 1
         now = self.sim_time
@@ -130,10 +169,12 @@ class World:
         return np.array(linear), np.array(angular)
 
     def set_model_state(self, name, pose: Pose, linear=(0, 0, 0), angular=(0, 0, 0)):
-        """Teleports a model (its model frame to `pose`, world frame) and sets its velocity."""
-        pose = checked_pose(pose, "model state of '%s'" % name, "nothing changed",
-                            linear=linear, angular=angular)
+        """Teleports a model (its model frame to `pose`, world frame) and sets its velocity.
+        An all-zero quaternion is the identity, as Gazebo normalizes it."""
         entity = self.entity(name)
+        pose = checked_pose(pose, "model state of '%s'" % name, "nothing changed",
+                            linear=linear, angular=angular, zero_is_identity=True)
+        self.layout_version += 1
         for index, body in enumerate(entity.body_ids):
             self._place(entity, index, pose.compose(entity.link_offsets[index]))
             self.client.resetBaseVelocity(body, list(linear), list(angular))
@@ -145,6 +186,8 @@ class World:
 
     def delete_model(self, name):
         entity = self.entity(name)
+        self.wrenches.forget_bodies(entity.body_ids)
+        self.layout_version += 1
         for body in entity.body_ids:
             self.caster.remove_body(body)
             self.client.removeBody(body)
@@ -167,7 +210,9 @@ class World:
     def reset_simulation(self):
         """reset_world, and sim time back to 0 (Gazebo's reset_simulation)."""
         self.reset_world()
+        self.wrenches.clear()               # their windows are in the sim time left behind
         self.step_count = 0
+        self._time_before, self._steps_before = 0.0, 0
         self.rng = np.random.default_rng(self.seed)
         for robot in self.robots():
             for part in robot.parts:
@@ -205,12 +250,7 @@ class World:
                                self.rng, self.warn, command_timeout=self.command_timeout,
                                legacy_mode_swaps=self.legacy_mode_swaps,
                                kinetic_legacy_mode=self.legacy_mode)
-            others = [(b, owner) for b, owner in self._body_owner.items()
-                      if not self.entities[owner].is_ground]
-            inside = overlapping(self.client, body, others)
-            if inside:
-                raise SpawnError("spawn pose (%.3f, %.3f, %.3f) puts '%s' inside %s; choose a "
-                                 "free pose" % (pose.position + (name, ", ".join(inside))))
+            self._warn_overlap(name, [body], pose)
             grounds = [(b, owner) for b, owner in self._body_owner.items()
                        if self.entities[owner].is_ground]
             below = grounds_above(self.client, body, grounds)
@@ -225,10 +265,50 @@ class World:
         inertial = Pose(*self.client.getDynamicsInfo(body, -1)[3:5])   # reliable for multibodies
         self._robots = None
         self.entities[name] = Entity(name, [body], [Pose()], [inertial], pose, static=False,
-                                     robot=robot)
+                                     robot=robot, link_names=[spec.root_link])
         self._body_owner[body] = name
         self.caster.add_body(body, static=False)
         return robot
+
+    def spawn_sdf(self, name: str, sdf_xml: str, pose: Pose, model_path=()):
+        """Adds the `<sdf><model>` (or `<sdf><include>`) of `sdf_xml` as model `name`, its
+        model frame at `pose` (world), as Gazebo's spawn_sdf_model does. Links with box,
+        cylinder, sphere or plane collisions become bodies; meshes are reported and left out.
+        Raises SpawnError (world unchanged) when it cannot."""
+        if not name or not name.strip():
+            raise SpawnError("model name is empty; pass -model NAME")
+        if name in self.entities:
+            raise SpawnError("SpawnModel: Failure - entity already exists: model '%s' is in the "
+                             "world; delete it first or choose another -model name" % name)
+        pose = checked_pose(pose, "spawn pose of '%s'" % name,
+                            "pass finite -x -y -z within the world and a unit quaternion "
+                            "(or -R -P -Y)", error=SpawnError)
+        try:
+            model, warnings = load_model_text(sdf_xml, model_path)
+        except ValueError as err:
+            raise SpawnError("model '%s': %s" % (name, err))
+        model = replace(model, name=name, pose=pose)
+        for message in warnings:
+            self.warn("spawned %s" % message.replace("model '%s'" % model.name, "'%s'" % name))
+        self._add_world_model(model)
+        if name not in self.entities:
+            raise SpawnError("model '%s' has no collision the stand-in can simulate (box, "
+                             "cylinder, sphere, plane); nothing spawned" % name)
+        entity = self.entities[name]
+        self._warn_overlap(name, entity.body_ids, pose)
+        return entity
+
+    def _warn_overlap(self, name, bodies, pose):
+        """Gazebo spawns a model inside another (physics then pushes them apart): so does
+        the stand-in, with a warning naming both."""
+        others = [(b, owner) for b, owner in self._body_owner.items()
+                  if owner != name and not self.entities[owner].is_ground]
+        inside = sorted({owner for body in bodies
+                         for owner in overlapping(self.client, body, others)})
+        if inside:
+            self.warn("spawn pose (%.3f, %.3f, %.3f) puts '%s' inside %s; spawned anyway, as "
+                      "Gazebo does (physics will push them apart)"
+                      % (tuple(pose.position) + (name, ", ".join("'%s'" % m for m in inside))))
 
     def positive_turn_direction(self, robot) -> Optional[str]:
         """Which way a positive angular.z turns the robot, as its drive says; None without
@@ -248,7 +328,8 @@ class World:
             return
         self.entities[model.name] = Entity(
             model.name, built.body_ids, built.link_offsets, built.inertial_offsets, model.pose,
-            model.static, is_ground=built.is_ground, shapes=built.shapes)
+            model.static, is_ground=built.is_ground, shapes=built.shapes,
+            link_names=[link.name for link in built.links], link_specs=built.links)
         if built.is_ground:
             self._grounds.add(model.name)
         for body, body_shapes in zip(built.body_ids, built.shapes):
