@@ -240,6 +240,7 @@ def set_link_state(world, ref: LinkRef, pose: Pose, linear, angular):
                          % (ref.scoped, ref.model))
     pose = checked_pose(pose, "link state of '%s'" % ref.scoped, "nothing changed",
                         linear=linear, angular=angular, zero_is_identity=True)
+    world.layout_version += 1
     world._place(entity, ref.body_slot, pose)
     com = world.client.getBasePositionAndOrientation(ref.body_id)[0]
     linear_com = _origin_velocity(linear, angular, pose.position, com)

@@ -1,0 +1,102 @@
+"""Gazebo's state topics, world frame, as gazebo_ros_api_plugin publishes them:
+  ~model_states (gazebo_msgs/ModelStates): every model's pose (model frame) and twist
+  ~link_states  (gazebo_msgs/LinkStates): every link's pose (link frame, `model::link`) and twist
+Published when the simulator node says they are due (its ~model_states_rate [Hz sim]), and
+built only while someone listens: for 32 models at 50 Hz, building ModelStates from scratch
+halved the loop's speed (issue 16). A static model's entry is computed once (it moves only when
+a service teleports it, which `World.layout_version` counts); the message objects are reused
+(rospy serializes a message inside publish()).
+"""
+import rospy
+from geometry_msgs.msg import Pose as PoseMsg, Twist
+from gazebo_msgs.msg import LinkStates, ModelStates
+
+from pybullet_gazebo.engine import model_access
+
+
+def _write(msg, index, state):
+    pose, linear, angular = state
+    target = msg.pose[index]
+    target.position.x, target.position.y, target.position.z = map(float, pose.position)
+    (target.orientation.x, target.orientation.y, target.orientation.z,
+     target.orientation.w) = map(float, pose.orientation)
+    twist = msg.twist[index]
+    twist.linear.x, twist.linear.y, twist.linear.z = map(float, linear)
+    twist.angular.x, twist.angular.y, twist.angular.z = map(float, angular)
+
+
+class _StatesMessage:
+    """One reusable ModelStates or LinkStates message and the rows that move."""
+
+    def __init__(self, msg_class, topic):
+        self.publisher = rospy.Publisher(topic, msg_class, queue_size=1)
+        self.msg = msg_class()
+        self._key = None
+        self._moving = []              # (row, function giving its (pose, linear, angular))
+
+    def publish(self, key, rows):
+        """rows() -> [(name, static, state function)], called only when `key` changed."""
+        if self._key != key:
+            self._rebuild(rows())
+            self._key = key
+        for index, state in self._moving:
+            _write(self.msg, index, state())
+        self.publisher.publish(self.msg)
+
+    def _rebuild(self, rows):
+        msg = self.msg
+        msg.name = [name for name, _, _ in rows]
+        msg.pose = [PoseMsg() for _ in rows]
+        msg.twist = [Twist() for _ in rows]
+        self._moving = []
+        for index, (_, static, state) in enumerate(rows):
+            if static:
+                _write(msg, index, state())
+            else:
+                self._moving.append((index, state))
+
+    def heard(self):
+        return self.publisher.get_num_connections() > 0
+
+
+class StateTopics:
+    def __init__(self, world):
+        self.world = world
+        self.model_states = _StatesMessage(ModelStates, "~model_states")
+        self.link_states = _StatesMessage(LinkStates, "~link_states")
+
+    def heard(self):
+        return self.model_states.heard() or self.link_states.heard()
+
+    def publish(self):
+        """Publishes the topics someone listens to. Call with the world's lock held."""
+        world = self.world
+        key = (world.layout_version, tuple(world.model_names()))
+        if self.model_states.heard():
+            self.model_states.publish(key, self._model_rows)
+        if self.link_states.heard():
+            self.link_states.publish(key, self._link_rows)
+
+    def _model_rows(self):
+        world = self.world
+        rows = []
+        for name in world.model_names():
+            def state(name=name):
+                linear, angular = model_access.model_twist(world, name)
+                return world.model_pose(name), linear, angular
+            rows.append((name, world.entities[name].static, state))
+        return rows
+
+    def _link_rows(self):
+        world = self.world
+        rows = []
+        for name in world.model_names():
+            static = world.entities[name].static
+            for ref in model_access.links_of(world, name):
+                rows.append((ref.scoped, static,
+                             lambda ref=ref: model_access.link_state(world, ref)))
+        return rows
+
+    def close(self):
+        self.model_states.publisher.unregister()
+        self.link_states.publisher.unregister()
