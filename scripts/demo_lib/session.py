@@ -99,9 +99,12 @@ class Session:
             return None
 
     def launch_world(self, world, gui=False, real_time_factor=0.0, lockstep=True, seed=0,
-                     paused=False, pub_clock_frequency=None, extra=()):
+                     paused=False, pub_clock_frequency=None, contacts=True, extra=()):
+        """Starts the world; `contacts` turns on /gazebo/contacts (the demo's summary and the
+        bench count touches from it)."""
         args = ["roslaunch", "--sigint-timeout=10", "--sigterm-timeout=3", "my_worlds",
                 "launch_world.launch", "world:=%s" % world, "gui:=%s" % str(bool(gui)).lower(),
+                "contacts:=%s" % str(bool(contacts)).lower(),
                 "real_time_factor:=%g" % real_time_factor,
                 "lockstep:=%s" % str(bool(lockstep)).lower(), "seed:=%d" % seed,
                 "pause:=%s" % str(bool(paused)).lower()]

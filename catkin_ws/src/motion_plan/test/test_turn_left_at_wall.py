@@ -110,6 +110,10 @@ class TurnLeftAtWallTest(unittest.TestCase):
                                 "the robot turned right (clockwise) at some point")
 
     def test_3_clears_the_wall_without_touching_it(self):
+        published = dict(rospy.get_published_topics())
+        self.assertEqual(published.get("/gazebo/contacts"), "gazebo_msgs/ContactsState",
+                         "the simulator does not publish /gazebo/contacts (contacts:=true?): "
+                         "cannot see touches")
         touches = [touch for touch in self.contacts.touches if touch[0] <= self.end]
         self.assertEqual(touches, [], "the robot touched something")
         t, x, y, yaw, speed = self.odom[-1]

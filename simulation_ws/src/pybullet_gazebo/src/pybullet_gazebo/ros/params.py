@@ -17,6 +17,8 @@ parameters (~name), with units:
   legacy_mode         true: diff drives as Kinetic's with <legacyMode>true whatever the URDF
                       says (m2wr turns counter-clockwise for a positive angular.z, as the
                       series' later programs expect); false: Noetic's, Gazebo's (clockwise)
+  contacts            also publish ~contacts (the stand-in's own topic, not Gazebo's): off by
+                      default, so the world offers exactly Gazebo's API
 Global: /use_sim_time (publish /clock).
 Each value is read with engine.parameters.ParameterReader: a bad one stops the node with a
 message naming the parameter, the value and the allowed range.
@@ -44,6 +46,7 @@ class SimulatorParams:
     gui: bool = False
     debug: bool = False
     legacy_mode: bool = False
+    contacts: bool = False
 
     @staticmethod
     def from_values(private, use_sim_time=True, where="gazebo"):
@@ -66,6 +69,7 @@ class SimulatorParams:
             gui=read.boolean("gui", d.gui),
             debug=read.boolean("debug", d.debug),
             legacy_mode=read.boolean("legacy_mode", d.legacy_mode),
+            contacts=read.boolean("contacts", d.contacts),
         )
 
     @staticmethod
