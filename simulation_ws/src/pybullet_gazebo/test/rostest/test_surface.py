@@ -4,11 +4,11 @@ it documents, with their types, and listens on localhost only.
 
 What node /gazebo publishes, subscribes and serves is read from the master (getSystemState)
 and from the node itself (ROS slave API: getPublications, getSubscriptions; service probes for
-type and md5sum), then compared with the list below: the simulator_node.py docstring's, plus
-what every rospy node has (/rosout, its own /clock subscription under /use_sim_time, the
-logger services). Sockets: every listening TCP socket and bound UDP socket the simulator
-process owns (its /proc/<pid>/fd inodes, looked up in /proc/<pid>/net/*) is on a loopback
-address, as env.sh's ROS_HOSTNAME=localhost asks.
+type and md5sum), then compared with Gazebo's API (gazebo_api.yaml, which the services'
+docstrings must list too) plus what m2wr's plugins add (laser scan, odometry, TF, cmd_vel).
+/gazebo/contacts is off (opt-in, contacts:=true). Sockets: every listening TCP socket and
+bound UDP socket the simulator process owns (its /proc/<pid>/fd inodes, looked up in
+/proc/<pid>/net/*) is on a loopback address, as env.sh's ROS_HOSTNAME=localhost asks.
 """
 import os
 import re
@@ -18,45 +18,54 @@ import unittest
 import xmlrpc.client
 
 import rosgraph
+import rospkg
 import rospy
 import rosservice
 import rostest
+import yaml
 from sensor_msgs.msg import LaserScan
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reliability import node_pid   # noqa: E402
-from pybullet_gazebo.ros import simulator_node   # noqa: E402
+from pybullet_gazebo.ros import (physics_reconfigure, physics_services,   # noqa: E402
+                                 property_services, spawn_services, state_services,
+                                 wrench_services)
 from pybullet_gazebo.ros.testing import wait_for_message   # noqa: E402
 
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "gazebo_api.yaml")) as _f:
+    GAZEBO_API = yaml.safe_load(_f)
+
+
+def _noetic_md5sums():
+    path = os.path.join(rospkg.RosPack().get_path("gazebo_msgs"), "test", "unit",
+                        "noetic_md5sums.txt")
+    with open(path) as source:
+        rows = [line.split() for line in source if line.strip() and not line.startswith("#")]
+    return {"gazebo_msgs/" + kind.split("/")[1]: md5sum for kind, md5sum in rows}
+
+
+NOETIC = _noetic_md5sums()
 EMPTY_MD5 = "d41d8cd98f00b204e9800998ecf8427e"        # std_srvs/Empty
-SERVICES = {  # name -> (type, md5sum); gazebo_msgs md5sums are ROS Noetic's
-    "/gazebo/reset_simulation": ("std_srvs/Empty", EMPTY_MD5),
-    "/gazebo/reset_world": ("std_srvs/Empty", EMPTY_MD5),
-    "/gazebo/pause_physics": ("std_srvs/Empty", EMPTY_MD5),
-    "/gazebo/unpause_physics": ("std_srvs/Empty", EMPTY_MD5),
-    "/gazebo/spawn_urdf_model": ("gazebo_msgs/SpawnModel", "9ed9c82c96abe1a00c3e8cdaeee24413"),
-    "/gazebo/spawn_sdf_model": ("gazebo_msgs/SpawnModel", "9ed9c82c96abe1a00c3e8cdaeee24413"),
-    "/gazebo/delete_model": ("gazebo_msgs/DeleteModel", "9ce56b4e9e54616de25d796dc972a262"),
-    "/gazebo/get_model_state": ("gazebo_msgs/GetModelState",
-                                "4c515e936d3319c9610c559c60bfc3d4"),
-    "/gazebo/set_model_state": ("gazebo_msgs/SetModelState",
-                                "5b3ab0281d4f5445def017e3a2e4a07b"),
-    "/gazebo/get_world_properties": ("gazebo_msgs/GetWorldProperties",
-                                     "36bb0f2eccf4d8be971410c22818ba3f"),
-    "/gazebo/get_physics_properties": ("gazebo_msgs/GetPhysicsProperties",
-                                       "575a5e74786981b7df2e3afc567693a6"),
-}
+RECONFIGURE_MD5 = "bb125d226a21982a4a98760418dc2672"   # dynamic_reconfigure/Reconfigure
 ROSPY_SERVICES = {"/gazebo/get_loggers": "roscpp/GetLoggers",
                   "/gazebo/set_logger_level": "roscpp/SetLoggerLevel"}
-PUBLICATIONS = {"/clock": "rosgraph_msgs/Clock",
-                "/gazebo/model_states": "gazebo_msgs/ModelStates",
-                "/gazebo/contacts": "gazebo_msgs/ContactsState",
-                "/m2wr/laser/scan": "sensor_msgs/LaserScan",     # m2wr's laser topicName
-                "/odom": "nav_msgs/Odometry",                      # its odometryTopic
-                "/tf": "tf2_msgs/TFMessage"}                       # odom -> link_chassis
+SERVICES = {  # name -> (type, md5sum): Gazebo's, gazebo_msgs md5sums ROS Noetic's
+    s["name"]: (s["type"], NOETIC.get(s["type"], EMPTY_MD5 if s["type"] == "std_srvs/Empty"
+                                      else RECONFIGURE_MD5))
+    for s in GAZEBO_API["services"] if s["name"] not in ROSPY_SERVICES}
+GAZEBO_PUBLICATIONS = {t["name"]: t["type"] for t in GAZEBO_API["topics"]
+                       if t["publishers"] == 1}
+PUBLICATIONS = dict(GAZEBO_PUBLICATIONS, **{
+    "/m2wr/laser/scan": "sensor_msgs/LaserScan",     # m2wr's laser topicName
+    "/odom": "nav_msgs/Odometry",                      # its odometryTopic
+    "/tf": "tf2_msgs/TFMessage"})                      # odom -> link_chassis
 ROSPY_PUBLICATIONS = {"/rosout": "rosgraph_msgs/Log"}
-SUBSCRIPTIONS = {"/cmd_vel": "geometry_msgs/Twist"}                # m2wr's commandTopic
+SUBSCRIPTIONS = {"/cmd_vel": "geometry_msgs/Twist",   # m2wr's commandTopic
+                 "/gazebo/set_model_state": "gazebo_msgs/ModelState",
+                 "/gazebo/set_link_state": "gazebo_msgs/LinkState"}
 # none from rospy: the simulator publishes /clock and does not listen to it
+SERVICE_MODULES = (physics_reconfigure, physics_services, property_services, spawn_services,
+                   state_services, wrench_services)
 
 
 def loopback(address):
@@ -106,13 +115,12 @@ class SurfaceTest(unittest.TestCase):
         self.assertIs(rospy.get_param("/rosout_disable_topics_generation"), False)
 
     def test_documented_services_are_the_ones_listed_here(self):
-        doc = simulator_node.__doc__
-        services = doc[doc.index("services are Gazebo's:"):doc.index("Topics out:")]
-        self.assertEqual({"/gazebo/" + name for name in re.findall(r"~(\w+)", services)},
-                         set(SERVICES))
-        topics = doc[doc.index("Topics out:"):doc.index("Topics in:")]
-        self.assertEqual(set(re.findall(r"^  (/\w+|~\w+) \(", topics, re.M)),
-                         {"/clock", "~model_states", "~contacts"})
+        documented = set()      # every ~name in the first paragraph of each module's docstring
+        for module in SERVICE_MODULES:
+            head = module.__doc__.split("\n\n")[0]
+            documented |= {"/gazebo/" + name for name in re.findall(r"~(\w+)", head)}
+        self.assertEqual(documented, set(SERVICES) | {"/gazebo/parameter_descriptions",
+                                                      "/gazebo/parameter_updates"})
 
     def test_publishes_exactly_its_topics_with_their_types(self):
         code, _, publications = self.node.getPublications("/test_surface")

@@ -2,7 +2,8 @@
   ~set_parameters (dynamic_reconfigure/Reconfigure)
   ~parameter_descriptions (dynamic_reconfigure/ConfigDescription), latched
   ~parameter_updates (dynamic_reconfigure/Config), latched
-and the parameters ~time_step [s], ~max_update_rate [Hz], ~gravity_x/y/z [m/s^2] plus ODE's
+
+Parameters: ~time_step [s], ~max_update_rate [Hz], ~gravity_x/y/z [m/s^2] plus ODE's
 solver settings. As in Gazebo, the server starts from what get_physics_properties reports and
 hands changes to set_physics_properties' logic (`physics.set`). time_step, max_update_rate and
 gravity take effect; ODE's settings have no meaning for Bullet: a change to one is reported
