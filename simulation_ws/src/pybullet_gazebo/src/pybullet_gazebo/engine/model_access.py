@@ -168,8 +168,9 @@ def frame_state(world, name):
     try:
         return link_state(world, find_link(world, name))
     except LookupError:
-        raise LookupError("reference frame '%s' is neither a model nor a link; leave it empty "
-                          "for the world, or name a model (%s) or a link as model::link"
+        raise LookupError("reference frame '%s' does not exist (neither a model nor a link); "
+                          "leave it empty for the world, or name a model (%s) or a link as "
+                          "model::link"
                           % (name, ", ".join(world.model_names()) or "none"))
 
 

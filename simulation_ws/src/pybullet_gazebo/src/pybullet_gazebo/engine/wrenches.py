@@ -141,9 +141,10 @@ class WrenchSchedule:
 
     def _push_joint(self, job):
         client = self.client
+        # pybullet gives the axis in the child's centre-of-mass frame (its "link frame")
         axis_local = client.getJointInfo(job.body_id, job.joint_index)[13]
         orientation = client.getLinkState(job.body_id, job.joint_index,
-                                          computeForwardKinematics=True)[5]
+                                          computeForwardKinematics=True)[1]
         axis = np.asarray(pybullet.getMatrixFromQuaternion(orientation)).reshape(3, 3) \
             @ np.asarray(axis_local, dtype=float)
         push = tuple(job.effort * axis)

@@ -16,6 +16,12 @@ def stamp_of(step_count, step_size):
     return rospy.Time(total // 1000000000, total % 1000000000)
 
 
+def stamp_of_world(world):
+    """rospy.Time of the world's sim time, exact (see World.sim_time_ns)."""
+    total = world.sim_time_ns()
+    return rospy.Time(total // 1000000000, total % 1000000000)
+
+
 def pose_to_msg(pose):
     return PoseMsg(Point(*pose.position), Quaternion(*pose.orientation))
 

@@ -115,15 +115,11 @@ class PhysicsServices:
         return EmptyResponse()
 
     def reset_simulation(self, _req):
-        with self.sim.lock:
-            self.sim.world.reset_simulation()
-            self.sim.after_reset()
+        self.sim.reset(simulation=True)
         rospy.loginfo("reset_simulation: models back at their initial poses, sim time 0")
         return EmptyResponse()
 
     def reset_world(self, _req):
-        with self.sim.lock:
-            self.sim.world.reset_world()
-            self.sim.after_reset()
+        self.sim.reset(simulation=False)
         rospy.loginfo("reset_world: models back at their initial poses")
         return EmptyResponse()

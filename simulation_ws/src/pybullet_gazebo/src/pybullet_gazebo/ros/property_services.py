@@ -63,7 +63,7 @@ class PropertyServices:
     def get_world_properties(self, _req):
         with self.sim.lock:
             return GetWorldPropertiesResponse(self.sim.world.sim_time, self.sim.world.model_names(),
-                                              self.sim.rendering, True,
+                                              self.sim.gui, True,
                                               "GetWorldProperties: got properties")
 
     def get_model_properties(self, req):

@@ -1,21 +1,21 @@
 """The ROS face of the stand-in: runs a World and talks to ROS the way Gazebo does.
 
-Node name `gazebo` (services: gazebo_services.py), so its services are Gazebo's:
-  ~reset_simulation, ~reset_world, ~pause_physics, ~unpause_physics  (std_srvs/Empty)
-  ~spawn_urdf_model (gazebo_msgs/SpawnModel), ~delete_model (gazebo_msgs/DeleteModel)
-  ~spawn_sdf_model (gazebo_msgs/SpawnModel): always answers false (URDF only)
-  ~get_model_state / ~set_model_state (gazebo_msgs/GetModelState / SetModelState)
-  ~get_world_properties / ~get_physics_properties
+Node name `gazebo`, so its services and topics are Gazebo's: the whole API of
+gazebo_ros_api_plugin (gazebo_services.py and the modules it lists), and
 Topics out:
   /clock (rosgraph_msgs/Clock) when /use_sim_time, at ~pub_clock_frequency [Hz sim]
-  ~model_states (gazebo_msgs/ModelStates) at ~model_states_rate [Hz sim]
-  ~contacts (gazebo_msgs/ContactsState) the (robot, model) pairs touching, the ground excluded,
-            each time that set changes (an empty list when the last touch ends)
+  ~model_states (gazebo_msgs/ModelStates), ~link_states (gazebo_msgs/LinkStates) at
+            ~model_states_rate [Hz sim], built only while someone listens (state_topics.py)
+  ~contacts (gazebo_msgs/ContactsState) only with ~contacts true (the stand-in's own, not
+            Gazebo's): the (robot, model) pairs touching, the ground excluded, each time
+            that set changes (an empty list when the last touch ends)
   per robot, what its parts' bindings publish (bindings.py): the laser's topicName
   (sensor_msgs/LaserScan) at the sensor's update_rate, the diff drive's odometryTopic
-  (nav_msgs/Odometry) and TF odometryFrame -> robotBaseFrame at its updateRate.
-Topics in: per robot, the diff drive's commandTopic (geometry_msgs/Twist). Not /clock: the
-node is its source (see nodes/gazebo_world).
+  (nav_msgs/Odometry) and TF odometryFrame -> robotBaseFrame at its updateRate (/tf is
+  advertised once a robot's drive needs it: an empty world has none, as Gazebo).
+Topics in: per robot, the diff drive's commandTopic (geometry_msgs/Twist); Gazebo's
+~set_model_state and ~set_link_state (state_services.py). Not /clock: the node is its
+source (see nodes/gazebo_world).
 Parameters: see params.py. All messages of one step carry that step's sim time; wall-clock
 pacing (real_time_factor, lockstep: pacing.py) lives in the adapter, never in the engine.
 """
@@ -25,7 +25,7 @@ import time
 
 import pybullet
 import rospy
-from gazebo_msgs.msg import ContactState, ContactsState, ModelStates
+from gazebo_msgs.msg import ContactState, ContactsState
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 from pybullet_utils.bullet_client import BulletClient
@@ -35,14 +35,16 @@ from pybullet_gazebo.ros import conversions
 from pybullet_gazebo.ros.bindings import BindingContext, RobotBindings
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
+from pybullet_gazebo.ros.state_topics import StateTopics
 
 
 class SimulatorNode:
     """Owns the World, the loop, /clock and the per-robot bindings; offers the Gazebo
     services the narrow interface they use (the `Simulation` protocol of gazebo_services)."""
 
-    def __init__(self, params, world_spec):
+    def __init__(self, params, world_spec, model_path=()):
         self.params = params
+        self.model_path = list(model_path)        # for spawn_sdf_model's model:// includes
         show_gui = params.gui and bool(os.environ.get("DISPLAY"))
         if params.gui and not show_gui:
             rospy.loginfo("gui requested but there is no display (DISPLAY is unset): running "
@@ -80,8 +82,9 @@ class SimulatorNode:
 
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) \
             if params.use_sim_time else None
-        self.model_states_pub = rospy.Publisher("~model_states", ModelStates, queue_size=1)
-        self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100, latch=True)
+        self.state_topics = StateTopics(self.world)
+        self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100,
+                                            latch=True) if params.contacts else None
         self.services = GazeboServices(self)
         rospy.loginfo("world '%s' loaded from %s: %d models, physics step %.4f s, "
                       "real_time_factor %s (%s)%s", world_spec.name, world_spec.source,
@@ -122,6 +125,22 @@ class SimulatorNode:
     def set_paused(self, paused):
         self.paused = paused
         self.pacer.restart(self.world.sim_time)
+
+    def set_real_time_factor(self, rtf):
+        """Sim seconds per wall second from now on; 0 = as fast as possible."""
+        self.real_time_factor = rtf
+        self.pacer.real_time_factor = rtf
+        self.pacer.restart(self.world.sim_time)
+
+    def step_size_changed(self):
+        """After world.set_step_size: publication periods are whole steps, recomputed."""
+        self._clock_every = self._steps_per_period(self.params.pub_clock_frequency)
+        self._model_states_every = self._steps_per_period(self.params.model_states_rate)
+        self._last_clock_step = self.world.step_count
+        self.pacer.restart(self.world.sim_time)
+
+    def stamp(self):
+        return conversions.stamp_of_world(self.world)
 
     def reset(self, simulation):
         """Gazebo's reset_simulation (`simulation` true: sim time back to 0) or reset_world."""
@@ -165,14 +184,14 @@ class SimulatorNode:
     def _publish(self, readings):
         """Publishes what is due after a step, stamped with its sim time; returns the number
         of scans published."""
-        touching = self.world.touching()
+        touching = self.world.touching() if self.contacts_pub is not None else []
         contacts_changed = touching != self._last_touching
         model_states_due = self.world.step_count % self._model_states_every == 0 \
-            and self.model_states_pub.get_num_connections() > 0     # costly: only if heard
+            and self.state_topics.heard()                          # costly: only if heard
         clock_due = self._clock_due(force=bool(readings))
         if not (readings or contacts_changed or model_states_due or clock_due):
             return 0
-        stamp = conversions.stamp_of(self.world.step_count, self.world.step_size)
+        stamp = conversions.stamp_of_world(self.world)
         if clock_due:
             self.clock_pub.publish(Clock(stamp))
         scans = 0
@@ -184,7 +203,7 @@ class SimulatorNode:
             self._last_touching = touching
             self._publish_contacts(touching, stamp)
         if model_states_due:
-            self.model_states_pub.publish(self.model_states())
+            self.state_topics.publish()
         return scans
 
     def _clock_now(self):
@@ -214,15 +233,6 @@ class SimulatorNode:
         msg.states = [ContactState(info="%s touches %s" % pair, collision1_name=pair[0],
                                    collision2_name=pair[1]) for pair in touching]
         self.contacts_pub.publish(msg)
-
-    def model_states(self):
-        msg = ModelStates()
-        for name in self.world.model_names():
-            linear, angular = self.world.model_twist(name)
-            msg.name.append(name)
-            msg.pose.append(conversions.pose_to_msg(self.world.model_pose(name)))
-            msg.twist.append(conversions.twist_to_msg(linear, angular))
-        return msg
 
     def shutdown(self):
         """rospy's shutdown hook. Ctrl-C's handler runs on the main thread, the one stepping,

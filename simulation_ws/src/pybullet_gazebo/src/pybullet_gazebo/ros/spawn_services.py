@@ -17,10 +17,12 @@ from pybullet_gazebo.engine import model_access
 from pybullet_gazebo.ros import conversions
 
 INVALID_URDF = ("SpawnModel: Failure - entity format is invalid: model_xml of '%s' is not a "
-                "URDF (its root is %s); call /gazebo/spawn_sdf_model for an SDF model")
+                "URDF: its root element is %s; call /gazebo/spawn_sdf_model for an SDF model")
 
 
 def _root_tag(text):
+    if not text.strip():
+        raise ValueError("model_xml is empty; send the model's URDF or SDF text")
     try:
         return ET.fromstring(text).tag
     except ET.ParseError as err:
@@ -54,7 +56,7 @@ class SpawnServices:
             return self._spawn(req, urdf=True)
         if root not in ("sdf", "gazebo"):
             return self._refused(req, "GazeboRosApiPlugin SpawnModel Failure: input model_xml "
-                                 "not SDF or URDF (its root is <%s>)" % root)
+                                 "not SDF or URDF: its root element is <%s>" % root)
         return self._spawn(req, urdf=False)
 
     def _refused(self, req, message):
@@ -72,15 +74,14 @@ class SpawnServices:
                     raise ValueError("SpawnModel: reference reference_frame not found (%s)" % err)
                 if frame is not None:
                     pose = frame[0].compose(pose)
-                if urdf:
-                    robot = world.spawn_urdf(req.model_name, req.model_xml, pose,
-                                             namespace=req.robot_namespace)
-                    self.sim.attach_robot(robot)
+                turning = None
+                if urdf:            # the node binds the robot's topics
+                    robot = self.sim.spawn_urdf(req.model_name, req.model_xml, pose,
+                                                namespace=req.robot_namespace)
                     turning = world.positive_turn_direction(robot)
                 else:
                     world.spawn_sdf(req.model_name, req.model_xml, pose,
                                     model_path=self.sim.model_path)
-                    turning = None
         except Exception as err:                 # any bad input: report, keep running
             return self._refused(req, str(err))
         x, y, z = pose.position
@@ -90,9 +91,7 @@ class SpawnServices:
 
     def delete_model(self, req):
         try:
-            with self.sim.lock:
-                self.sim.world.delete_model(req.model_name)
-                self.sim.detach_robot(req.model_name)
+            self.sim.delete_model(req.model_name)
         except LookupError as err:
             return DeleteModelResponse(False, "DeleteModel: %s" % err)
         return DeleteModelResponse(True, "DeleteModel: successfully deleted model")
