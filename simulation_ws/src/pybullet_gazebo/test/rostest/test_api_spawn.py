@@ -32,6 +32,8 @@ class SpawnDelete(unittest.TestCase):
         self.assertIn("m2wr", self.names())
 
     def test_sdf_spawn_in_a_reference_frame_and_delete(self):
+        self.gazebo.pause_physics()               # m2wr may still roll after another test
+        self.addCleanup(self.gazebo.unpause_physics)
         answer = self.gazebo.spawn_sdf_model("crate_rel", CRATE_SDF, "", pose(2.0, 1.0, 0.05),
                                              "m2wr")
         self.assertTrue(answer.success, answer.status_message)
