@@ -47,8 +47,7 @@ class StateServices:
                 if req.model_name not in world.entities:
                     raise ModelNotFound("model '%s' does not exist; models are: %s"
                                         % (req.model_name, ", ".join(world.model_names())))
-                linear, angular = model_access.model_twist(world, req.model_name)
-                state = (world.model_pose(req.model_name), linear, angular)
+                state = model_access.model_state(world, req.model_name)
                 frame = model_access.frame_state(world, req.relative_entity_name)
                 pose, linear, angular = model_access.relative_state(state, frame)
                 stamp = self.sim.stamp()

@@ -81,10 +81,8 @@ class StateTopics:
         world = self.world
         rows = []
         for name in world.model_names():
-            def state(name=name):
-                linear, angular = model_access.model_twist(world, name)
-                return world.model_pose(name), linear, angular
-            rows.append((name, world.entities[name].static, state))
+            rows.append((name, world.entities[name].static,
+                         lambda name=name: model_access.model_state(world, name)))
         return rows
 
     def _link_rows(self):
