@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""rostest, Gazebo's force services as a Gazebo user sees them (empty world, real time, m2wr and
+"""rostest, Gazebo's force services as a Gazebo user sees them (empty world at 4x real time, m2wr and
 a 2 kg SDF crate): apply_body_wrench pushes for its duration of sim time (from its start_time;
 a negative duration until clear_body_wrenches), apply_joint_effort turns a wheel until
 clear_joint_forces; bad input answered success false, naming the input, nothing applied."""

@@ -156,6 +156,16 @@ def test_a_wrench_waits_for_its_start_time_and_a_negative_duration_lasts_until_c
     assert speed(world)[0][1] == pytest.approx(before, abs=1e-6)
 
 
+def test_a_wrench_wakes_a_body_that_fell_asleep_at_rest(world):
+    world.spawn_sdf("crate", BOX_SDF, Pose.from_xyz_rpy(0, 0, 0.2))
+    run(world, 3.0)                                     # settled: Bullet puts it to sleep
+    ref = model_access.find_link(world, "crate::body")
+    world.wrenches.add_body_wrench(ref.scoped, ref.body_id, -1, (0, 0, 40.0), (0, 0, 0),
+                                   start=0.0, duration=0.5, now=world.sim_time)
+    run(world, 0.5)
+    assert world.model_pose("crate").position[2] > 1.0
+
+
 def test_deleting_a_model_drops_its_jobs(world):
     ref = floating_crate(world)
     world.wrenches.add_body_wrench(ref.scoped, ref.body_id, -1, (1, 0, 0), (0, 0, 0),

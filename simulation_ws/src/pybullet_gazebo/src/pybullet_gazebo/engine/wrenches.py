@@ -118,6 +118,7 @@ class WrenchSchedule:
         if self._wrenches:
             for job in self._wrenches:
                 if job.active(now):
+                    self._wake(job.body_id)
                     self.client.applyExternalForce(job.body_id, job.link_index, job.force,
                                                    self._centre_of_mass(job.body_id, job.link_index),
                                                    pybullet.WORLD_FRAME)
@@ -127,12 +128,18 @@ class WrenchSchedule:
         if self._efforts:
             for job in self._efforts:
                 if job.active(now):
+                    self._wake(job.body_id)
                     self._push_joint(job)
             self._efforts = [job for job in self._efforts if not job.expired(now)]
         for (body, link) in self._weightless:
             mass = self.client.getDynamicsInfo(body, link)[0]
             self.client.applyExternalForce(body, link, tuple(-mass * self.gravity),
                                            self._centre_of_mass(body, link), pybullet.WORLD_FRAME)
+
+    def _wake(self, body):
+        """Bullet ignores forces on a sleeping body (Gazebo lets resting bodies sleep too,
+        and wakes them when pushed)."""
+        self.client.changeDynamics(body, -1, activationState=pybullet.ACTIVATION_STATE_WAKE_UP)
 
     def _centre_of_mass(self, body, link):
         if link < 0:
