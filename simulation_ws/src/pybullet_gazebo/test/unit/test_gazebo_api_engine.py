@@ -166,6 +166,14 @@ def test_a_wrench_wakes_a_body_that_fell_asleep_at_rest(world):
     assert world.model_pose("crate").position[2] > 1.0
 
 
+def test_a_twist_set_on_a_sleeping_body_moves_it(world):
+    world.spawn_sdf("crate", BOX_SDF, Pose.from_xyz_rpy(0, 0, 0.2))
+    run(world, 3.0)                                     # settled: Bullet puts it to sleep
+    world.set_model_state("crate", world.model_pose("crate"), linear=(0, 0, 3.0))
+    run(world, 0.2)
+    assert world.model_pose("crate").position[2] > 0.5
+
+
 def test_deleting_a_model_drops_its_jobs(world):
     ref = floating_crate(world)
     world.wrenches.add_body_wrench(ref.scoped, ref.body_id, -1, (1, 0, 0), (0, 0, 0),

@@ -253,6 +253,9 @@ def set_link_state(world, ref: LinkRef, pose: Pose, linear, angular):
     com = world.client.getBasePositionAndOrientation(ref.body_id)[0]
     linear_com = _origin_velocity(linear, angular, pose.position, com)
     world.client.resetBaseVelocity(ref.body_id, list(linear_com), list(angular))
+    if not entity.static:                   # a sleeping body would ignore its new twist
+        world.client.changeDynamics(ref.body_id, -1,
+                                    activationState=pybullet.ACTIVATION_STATE_WAKE_UP)
     if entity.static:
         world.caster.reset()
 

@@ -178,6 +178,9 @@ class World:
         for index, body in enumerate(entity.body_ids):
             self._place(entity, index, pose.compose(entity.link_offsets[index]))
             self.client.resetBaseVelocity(body, list(linear), list(angular))
+            if not entity.static:           # a sleeping body would ignore its new twist
+                self.client.changeDynamics(body, -1,
+                                           activationState=pybullet.ACTIVATION_STATE_WAKE_UP)
         if entity.static:
             self.caster.reset()             # it caches static shapes where they were
         if entity.robot is not None:
