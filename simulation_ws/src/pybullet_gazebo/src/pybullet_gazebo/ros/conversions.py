@@ -9,15 +9,9 @@ from sensor_msgs.msg import LaserScan
 from pybullet_gazebo.engine.transforms import Pose
 
 
-def stamp_of(step_count, step_size):
-    """rospy.Time of a step, computed in integer nanoseconds so it never drifts."""
-    step_ns = int(round(step_size * 1e9))
-    total = step_count * step_ns
-    return rospy.Time(total // 1000000000, total % 1000000000)
-
-
 def stamp_of_world(world):
-    """rospy.Time of the world's sim time, exact (see World.sim_time_ns)."""
+    """rospy.Time of the world's sim time, in integer nanoseconds so it never drifts, also
+    across a change of the time step (see World.sim_time_ns)."""
     total = world.sim_time_ns()
     return rospy.Time(total // 1000000000, total % 1000000000)
 
