@@ -288,6 +288,7 @@ def test_time_step_change_keeps_sim_time_running_on(world):
     for _ in range(500):
         world.step()
     assert world.sim_time == pytest.approx(1.5, abs=1e-9)
+    assert world.sim_time_ns() == 1500000000            # the stamps: exact, no drift
     with pytest.raises(ValueError, match="time_step"):
         world.set_step_size(0.0)
     assert world.step_size == 0.001
