@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
 """rostest, Gazebo's spawn and delete services as a Gazebo user sees them (empty world):
-spawn_urdf_model (m2wr), spawn_sdf_model (an SDF crate, also a URDF as Gazebo takes), a
+spawn_urdf_model (m2wr), spawn_sdf_model (an SDF crate, also a URDF as Gazebo takes; through
+spawn_model -sdf from a file and from -database), a
 reference frame, a model spawned inside another (spawned, with a warning), delete_model; a
 duplicate name, XML that does not parse, a NaN pose, an unknown frame, an SDF sent to
 spawn_urdf_model and an empty name answered success false, the world unchanged."""
 import os
+import subprocess
 import sys
+import tempfile
 import unittest
 
 import rospy
@@ -50,6 +53,18 @@ class SpawnDelete(unittest.TestCase):
         self.assertTrue(answer.success, answer.status_message)
         self.assertIn("m2wr_b", self.names())
         self.gazebo.delete_model("m2wr_b")
+
+    def test_spawn_model_client_spawns_sdf_from_a_file_and_from_the_database(self):
+        with tempfile.NamedTemporaryFile("w", suffix=".sdf", delete=False) as sdf:
+            sdf.write(CRATE_SDF)
+        self.addCleanup(os.unlink, sdf.name)
+        for args, name in ((["-file", sdf.name], "crate_file"), (["-database", "coke_can"], "can")):
+            result = subprocess.run(["rosrun", "pybullet_gazebo", "spawn_model", "-sdf", "-model",
+                                     name, "-x", "4", "-y", "-4"] + args,
+                                    capture_output=True, text=True, timeout=60)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertIn(name, self.names())
+            self.assertTrue(self.gazebo.delete_model(name).success)
 
     def test_a_model_inside_another_is_spawned(self):
         answer = self.gazebo.spawn_sdf_model("crate_in", CRATE_SDF, "", pose(0.0, 0.0, 0.1), "")

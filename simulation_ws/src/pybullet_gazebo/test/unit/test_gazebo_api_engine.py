@@ -75,6 +75,15 @@ def test_sdf_box_spawns_where_asked_falls_and_rests_on_the_ground(world):
     assert not props.is_static
 
 
+def test_sdf_include_by_uri_as_spawn_model_database_sends_it(world):
+    text = ("<sdf version='1.4'><world name='default'><include><uri>model://coke_can</uri>"
+            "</include></world></sdf>")
+    world.spawn_sdf("can", text, Pose.from_xyz_rpy(1, 1, 0.0),
+                    model_path=[os.path.join(SRC, "pybullet_gazebo", "models")])
+    run(world, 0.5)
+    assert world.model_pose("can").position[:2] == pytest.approx((1.0, 1.0), abs=0.01)
+
+
 def test_sdf_mesh_collisions_are_reported_and_the_rest_simulated(world):
     world.spawn_sdf("pair", TWO_LINKS_SDF, Pose.from_xyz_rpy(0, 0, 0.5))
     assert any("mesh" in w and "'pair'" in w for w in world.warnings)

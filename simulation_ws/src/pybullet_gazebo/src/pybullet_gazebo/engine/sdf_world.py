@@ -128,7 +128,8 @@ def load_world(path, model_path):
 
 def load_model_text(text, model_path=()):
     """(ModelSpec, warnings) of the model in an SDF text, as spawn_sdf_model receives it:
-    `<sdf><model>` or `<sdf><include>` (Gazebo also takes a `<gazebo>` root). The model's pose
+    `<sdf><model>` or `<sdf><include>`, also inside a `<world>` (as spawn_model -database
+    sends it); Gazebo also takes a `<gazebo>` root. The model's pose
     and name are its own; the caller replaces them. ValueError, naming what is wrong, for text
     that is not such a model."""
     try:
@@ -141,12 +142,13 @@ def load_model_text(text, model_path=()):
         raise ValueError("model_xml's root element is <%s>; an SDF model is <sdf version='1.6'>"
                          "<model name='...'>..." % root.tag)
     reader = _WorldReader("<spawn_sdf_model request>", model_path)
-    elem = root.find("model")
+    parent = root.find("world") if root.find("world") is not None else root
+    elem = parent.find("model")       # spawn_model -database sends <sdf><world><include>
     try:
         if elem is not None:
             model = reader.model(elem)
-        elif root.find("include") is not None:
-            model = reader.include(root.find("include"), "spawn request")
+        elif parent.find("include") is not None:
+            model = reader.include(parent.find("include"), "spawn request")
         else:
             raise ValueError("model_xml has no <model> (nor <include>) under <%s>; the stand-in "
                              "spawns models (lights and actors are not simulated)" % root.tag)
