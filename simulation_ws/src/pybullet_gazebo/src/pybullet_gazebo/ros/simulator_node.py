@@ -211,8 +211,7 @@ class SimulatorNode:
         that loop on rospy.Rate, whose tick may have fallen since the last /clock."""
         with self.lock:
             if self.world.step_count != self._last_clock_step and self._clock_due(force=True):
-                self.clock_pub.publish(Clock(conversions.stamp_of(self.world.step_count,
-                                                                  self.world.step_size)))
+                self.clock_pub.publish(Clock(conversions.stamp_of_world(self.world)))
 
     def _clock_due(self, force):
         """/clock every _clock_every steps and on each step with readings (`force`), counted

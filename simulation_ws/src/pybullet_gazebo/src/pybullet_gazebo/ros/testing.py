@@ -97,17 +97,27 @@ class NodeLog:
 
 class ContactLog:
     """Every touch the simulator reports on its latched /gazebo/contacts topic: `touches` is a
-    list of (sim time [s], ["robot touches model", ...]), one per non-empty message."""
+    list of (sim time [s], ["robot touches model", ...]), one per non-empty message.
+    /gazebo/contacts is opt-in (launch arg contacts:=true): reading `touches` while no
+    simulator publishes it raises AssertionError, so a test cannot pass by seeing nothing."""
 
     def __init__(self, topic="/gazebo/contacts"):
         from gazebo_msgs.msg import ContactsState
-        self.touches = []
+        self.topic = topic
+        self._touches = []
         self.messages = 0
         self._sub = rospy.Subscriber(topic, ContactsState, self._on_contacts, queue_size=1000)
+
+    @property
+    def touches(self):
+        if self.messages == 0 and self._sub.get_num_connections() == 0:
+            raise AssertionError("nothing publishes %s: launch the world with contacts:=true "
+                                 "(param /gazebo/contacts) to see touches" % self.topic)
+        return self._touches
 
     def _on_contacts(self, msg):
         self.messages += 1
         if msg.states:
-            self.touches.append((msg.header.stamp.to_sec(),
-                                 ["%s touches %s" % (s.collision1_name, s.collision2_name)
-                                  for s in msg.states]))
+            self._touches.append((msg.header.stamp.to_sec(),
+                                  ["%s touches %s" % (s.collision1_name, s.collision2_name)
+                                   for s in msg.states]))
