@@ -26,6 +26,7 @@ from tf2_msgs.msg import TFMessage
 from pybullet_gazebo.engine.diff_drive import DiffDrive
 from pybullet_gazebo.engine.ray_sensor import RaySensor
 from pybullet_gazebo.ros import conversions, robot_namespace
+from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 
 
 @dataclass
@@ -74,7 +75,7 @@ class Binding:
 class LaserBinding(Binding):
     def __init__(self, robot, part, context):
         super().__init__(robot, part, context)
-        self.scans = rospy.Publisher(self.topic(part.topic), LaserScan, queue_size=1)
+        self.scans = DirectPublisher(self.topic(part.topic), LaserScan)   # see its docstring
         self.publishers.append(self.scans)
         self.frame_id = self.frame(part.frame_id, fall_back_to_namespace=False)
 

@@ -33,6 +33,7 @@ from pybullet_utils.bullet_client import BulletClient
 from pybullet_gazebo.engine.world import World
 from pybullet_gazebo.ros import conversions
 from pybullet_gazebo.ros.bindings import BindingContext, RobotBindings
+from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
 
@@ -78,8 +79,7 @@ class SimulatorNode:
         self._last_clock_step = 0
         self._model_states_every = self._steps_per_period(params.model_states_rate)
 
-        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) \
-            if params.use_sim_time else None
+        self.clock_pub = DirectPublisher("/clock", Clock) if params.use_sim_time else None
         self.model_states_pub = rospy.Publisher("~model_states", ModelStates, queue_size=1)
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100, latch=True)
         self.services = GazeboServices(self)
@@ -232,7 +232,8 @@ class SimulatorNode:
             self._disconnect()
 
     def _disconnect(self):
-        try:
-            self.client.disconnect()
-        except pybullet.error:
-            pass
+        with self.lock:           # a service thread still inside the world finishes first
+            try:
+                self.client.disconnect()
+            except pybullet.error:
+                pass
