@@ -48,7 +48,7 @@ def run(world, seconds):
 
 
 def component(robot, kind):
-    return next(c for c in robot.components if isinstance(c, kind))
+    return next(p for p in robot.parts if isinstance(p, kind))
 
 
 def drift_over(world, seconds):

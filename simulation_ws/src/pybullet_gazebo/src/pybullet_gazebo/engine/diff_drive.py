@@ -15,7 +15,9 @@ Plugin parameters, read as Noetic reads them (default in brackets):
   commandTopic [cmd_vel], odometryTopic [odom], odometryFrame [odom],
   robotBaseFrame [base_footprint], odometrySource [world | encoder]
   publishTf [true]           false: Noetic publishes no odometry at all (due() stays false)
-  publishOdomTF [true], publishWheelTF [false], publishWheelJointState [false]
+  publishOdomTF [true], publishWheelTF [false], publishWheelJointState [false: the
+                             stand-in publishes the wheel joint states whatever it says,
+                             see joint_states.py]
   legacyMode                 removed in Melodic (gazebo_ros_pkgs #707) and not read by Noetic:
                              `true` only draws a warning, unless the component is built with
                              legacy_mode_swaps=True to emulate Kinetic and older, where
@@ -125,7 +127,7 @@ class DiffDrive(Part):
         self.wheel_acceleration = number("wheelAcceleration", 0.0, minimum=0.0)     # [m/s^2]
         self.wheel_torque = number("wheelTorque", 5.0, minimum=0.0)                 # [N m]
         self.update_rate = number("updateRate", 100.0)                              # [Hz]
-        for tag in ("publishWheelTF", "publishWheelJointState"):
+        for tag in ("publishWheelTF",):     # publishWheelJointState: see joint_states.py
             if boolean(tag, False):
                 self._warn_once("%s: <%s>true is not simulated by the stand-in; ignored"
                                 % (where, tag))

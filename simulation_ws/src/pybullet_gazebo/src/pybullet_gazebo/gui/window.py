@@ -81,7 +81,7 @@ class GuiWindow:
     # --- what the simulator tells it --------------------------------------------------
     def add_robot(self, robot, urdf_xml):
         flags = urdf_sensors_visualized(urdf_xml)
-        sensors = [c for c in robot.components if isinstance(c, RaySensor)
+        sensors = [c for c in robot.parts if isinstance(c, RaySensor)
                    and (self.rays == "true"
                         or (self.rays == "sdf" and flags.get(c.spec.name, False)))]
         self._robots[robot.name] = (robot, sensors)
