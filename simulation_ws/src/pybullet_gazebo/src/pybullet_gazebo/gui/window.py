@@ -32,6 +32,9 @@ F_SETPIPE_SZ = 1031           # Linux fcntl: set a pipe's buffer size
 MAX_BEAMS_SENT = 240          # beams per visualized sensor (every k-th of the scan)
 
 
+VIEWER = [sys.executable, "-m", "pybullet_gazebo.gui.viewer"]
+
+
 def open_window(world, fps=30.0, rays="sdf", follow=False, info=print, warn=print):
     """A GuiWindow on $DISPLAY, or None (with a warning saying why) when no window can be
     opened. `rays`: "sdf" draws the beams of sensors whose <visualize> is true (Gazebo's
@@ -48,14 +51,13 @@ def open_window(world, fps=30.0, rays="sdf", follow=False, info=print, warn=prin
 
 
 class GuiWindow:
-    def __init__(self, world, fps, rays, follow, info, warn):
+    def __init__(self, world, fps, rays, follow, info, warn, viewer=VIEWER):
         self.world = world
         self.period = 1.0 / fps if fps > 0 else 0.0        # [s] wall between frames
         self.rays = rays
         self.info, self.warn = info, warn
         self._process = subprocess.Popen(
-            [sys.executable, "-m", "pybullet_gazebo.gui.viewer", "--fps", repr(float(fps)),
-             "--follow", "true" if follow else "false"],
+            list(viewer) + ["--fps", repr(float(fps)), "--follow", "true" if follow else "false"],
             stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, env=os.environ.copy())
         try:       # a pipe of one page: at most about one frame waits in it, never a backlog
             fcntl.fcntl(self._process.stdin.fileno(), F_SETPIPE_SZ, 4096)
@@ -99,8 +101,8 @@ class GuiWindow:
         if not self._open:
             return
         for reading in readings:
-            if isinstance(reading.component, RaySensor):
-                self._scans[id(reading.component)] = reading.data
+            if isinstance(reading.part, RaySensor):
+                self._scans[id(reading.part)] = reading.data
         now = time.monotonic()
         if now < self._next_frame:
             return
