@@ -28,7 +28,7 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from ..engine.appearance import DEFAULT_COLOUR, urdf_link_colours
-from ..engine.robot_description import strip_for_bullet
+from ..engine.robot_description import parse_robot, strip_for_bullet
 from ..engine.specs import Box, Cylinder, Plane, Sphere
 from ..engine.transforms import Pose
 
@@ -137,7 +137,7 @@ class Viewer:
         handle, path = tempfile.mkstemp(prefix="pybullet_gazebo_view_", suffix=".urdf")
         try:
             with os.fdopen(handle, "w") as out:
-                out.write(strip_for_bullet(urdf_xml))
+                out.write(strip_for_bullet(parse_robot(urdf_xml, name)))
             body = self.client.loadURDF(path, useFixedBase=True,
                                         flags=pybullet.URDF_USE_IMPLICIT_CYLINDER)
         finally:
