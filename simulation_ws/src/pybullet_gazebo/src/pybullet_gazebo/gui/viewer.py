@@ -16,15 +16,20 @@ real-time factor at the top. pybullet renders at most `fps` frames per second
 (--minGraphicsUpdateTimeMs, in microseconds despite its name). The viewer ends when stdin
 closes (the simulator ended) or its window is closed; Ctrl-C ends it quietly.
 """
-import argparse
-import math
-import os
-import pickle
 import signal
-import sys
-import tempfile
 
-import pybullet
+# Ctrl-C or SIGTERM end the viewer at once, also while it still imports: no traceback
+signal.signal(signal.SIGINT, signal.SIG_DFL)
+signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import os  # noqa: E402
+import pickle  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+
+import pybullet  # noqa: E402
 from pybullet_utils.bullet_client import BulletClient
 
 from ..engine.appearance import DEFAULT_COLOUR, urdf_link_colours
@@ -241,8 +246,6 @@ def main(argv=None):
     parser.add_argument("--fps", type=float, default=30.0)
     parser.add_argument("--follow", default="false")
     args = parser.parse_args(argv)
-    signal.signal(signal.SIGINT, signal.SIG_DFL)   # Ctrl-C in the terminal: end, no traceback
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     viewer = Viewer(args.fps, args.follow.lower() in ("true", "1"))
     source = sys.stdin.buffer
     handlers = {"world": viewer.world, "robot": viewer.robot, "remove": viewer.remove,

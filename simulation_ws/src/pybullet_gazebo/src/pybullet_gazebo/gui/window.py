@@ -58,7 +58,10 @@ class GuiWindow:
         self.info, self.warn = info, warn
         self._process = subprocess.Popen(
             list(viewer) + ["--fps", repr(float(fps)), "--follow", "true" if follow else "false"],
-            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, env=os.environ.copy())
+            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, env=os.environ.copy(),
+            # a session of its own: a terminal's Ctrl-C goes to the simulator, which ends the
+            # viewer by closing its stdin (also when the simulator is killed)
+            start_new_session=True)
         try:       # a pipe of one page: at most about one frame waits in it, never a backlog
             fcntl.fcntl(self._process.stdin.fileno(), F_SETPIPE_SZ, 4096)
         except OSError:
