@@ -34,7 +34,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from ..engine.appearance import DEFAULT_COLOUR, urdf_link_colours
 from ..engine.robot_description import parse_robot, strip_for_bullet
-from ..engine.specs import Box, Cylinder, Plane, Sphere
+from ..engine.specs import Box, Cylinder, Plane, Sphere, TriangleMesh
 from ..engine.transforms import Pose
 
 HIT_COLOUR = (0.15, 0.35, 1.0)
@@ -114,7 +114,7 @@ class Viewer:
 
     def _visual_shape(self, collision, colour):
         """(visual shape id, offset of the drawn shape in the collision frame); None for a
-        geometry it cannot draw (meshes are not drawn)."""
+        geometry it cannot draw (a mesh the world file could not read is not drawn)."""
         geometry = collision.geometry
         create = self.client.createVisualShape
         if isinstance(geometry, Box):
@@ -125,6 +125,10 @@ class Viewer:
                           length=geometry.length, rgbaColor=colour), Pose()
         if isinstance(geometry, Sphere):
             return create(pybullet.GEOM_SPHERE, radius=geometry.radius,
+                          rgbaColor=colour), Pose()
+        if isinstance(geometry, TriangleMesh) and len(geometry.faces):
+            return create(pybullet.GEOM_MESH, vertices=geometry.vertices.tolist(),
+                          indices=[int(i) for i in geometry.faces.reshape(-1)],
                           rgbaColor=colour), Pose()
         if isinstance(geometry, Plane) and tuple(geometry.normal) == (0.0, 0.0, 1.0):
             half = [geometry.size[0] / 2, geometry.size[1] / 2, PLANE_THICKNESS / 2]
