@@ -53,7 +53,8 @@ PUBLICATIONS = {"/clock": "rosgraph_msgs/Clock",
                 "/gazebo/contacts": "gazebo_msgs/ContactsState",
                 "/m2wr/laser/scan": "sensor_msgs/LaserScan",     # m2wr's laser topicName
                 "/odom": "nav_msgs/Odometry",                      # its odometryTopic
-                "/tf": "tf2_msgs/TFMessage"}                       # odom -> link_chassis
+                "/tf": "tf2_msgs/TFMessage",                       # odom -> link_chassis
+                "/joint_states": "sensor_msgs/JointState"}         # its wheels, for rviz
 ROSPY_PUBLICATIONS = {"/rosout": "rosgraph_msgs/Log"}
 SUBSCRIPTIONS = {"/cmd_vel": "geometry_msgs/Twist"}                # m2wr's commandTopic
 # none from rospy: the simulator publishes /clock and does not listen to it
