@@ -21,7 +21,22 @@ Figures:
   peak memory       VmHWM of the simulator process after the lockstep run
   --soak MINUTES    lockstep loop for MINUTES of wall time: scan rate in sim time, missing
                     scans, simulator RSS at start and end (growth %), ERROR lines in the logs
+  listeners         the lockstep loop again with a /gazebo/model_states subscriber,
+                    robot_state_publisher and /tf and /joint_states subscribers attached (what
+                    rviz and a Gazebo tool would add); printed as a ratio to the loop without,
+                    and the loop's ratio to World.step alone, both from the same run
 The machine is shared: the load average before and after is recorded with the figures.
+
+Where the simulator's time goes (profile recipe): run the loop (scripts/demo.sh, or
+`roslaunch my_worlds launch_world.launch gui:=false real_time_factor:=0 lockstep:=true`, spawn
+and the controller), then sample the simulator's main thread in wall time:
+  pip install py-spy   (not a dependency of the project)
+  py-spy record --idle --nonblocking -d 20 -f speedscope -o sim.json -p $(pgrep -f gazebo_world)
+and open sim.json in https://www.speedscope.app, thread "MainThread". --idle matters: without
+it, rospy's threads blocked in select/recv are not counted and the main thread's own waits
+(lockstep, time.sleep(0) in a queued publisher's write_data) are missed. Figures of issue 16
+(before DirectPublisher): Bullet's step 28 %, ray casting 13 %, /clock 14 %, scan 10 %,
+waiting for the controller 23 %; about 20 % was rospy's queued publish's time.sleep(0).
 """
 import argparse
 import json
@@ -221,15 +236,37 @@ def start_loop(session, lockstep, clock_hz):
     return session.node_pid("/gazebo"), session.children["controller"].pid
 
 
+# "rviz-like" listeners: a /gazebo/model_states subscriber, robot_state_publisher on
+# /joint_states (it publishes the wheels' TF), and subscribers of /tf and /joint_states.
+# `rostopic hz` takes messages raw (AnyMsg), so they cost the simulator's publishing, not
+# their own deserializing.
+WATCHERS = {
+    "watch_model_states": ["rostopic", "hz", "/gazebo/model_states"],
+    "robot_state_publisher": ["rosrun", "robot_state_publisher", "robot_state_publisher"],
+    "watch_tf": ["rostopic", "hz", "/tf"],
+    "watch_joint_states": ["rostopic", "hz", "/joint_states"],
+}
+
+
+def start_watchers(session):
+    for name, argv in WATCHERS.items():
+        session._start(name, argv)
+    time.sleep(3.0)                      # they connect while physics is paused
+
+
 def stop_loop(session):
-    session.stop(["controller", "spawn", "world"])
+    session.stop([n for n in WATCHERS if n in session.children]
+                 + ["controller", "spawn", "world"])
 
 
-def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_seconds, warmup=2.0):
-    say("%s: simulator real_time_factor 0, lockstep %s, /clock %g Hz" % (
-        name, str(lockstep).lower(), clock_hz))
+def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_seconds, warmup=2.0,
+                 watchers=False):
+    say("%s: simulator real_time_factor 0, lockstep %s, /clock %g Hz%s" % (
+        name, str(lockstep).lower(), clock_hz, ", with listeners" if watchers else ""))
     sim_pid, ctrl_pid = start_loop(session, lockstep, clock_hz)
     try:
+        if watchers:
+            start_watchers(session)
         call_empty("/gazebo/unpause_physics")
         time.sleep(warmup)
         session.check_running(["world", "controller"])
@@ -406,6 +443,16 @@ def report(figures):
         "one 720-beam scan (RaySensor.measure) %6.3f ms mean of %d" % (
             engine["scan"]["ms_mean"], engine["scan"]["scans"]),
     ]
+    lockstep = loops.get("lockstep", {}).get("x_real_time")
+    watched = loops.get("lockstep + listeners", {}).get("x_real_time")
+    step_alone = engine["engine_step"]["x_real_time"]
+    lines += [
+        "ratios (same run):",
+        "  lockstep loop with listeners / without   %s %% (target >= 90 %%)" % (
+            fmt(100.0 * watched / lockstep if lockstep and watched else None, "%.0f")),
+        "  lockstep loop / World.step alone         %s %% (target >= 60 %%)" % (
+            fmt(100.0 * lockstep / step_alone if lockstep and step_alone else None, "%.0f")),
+    ]
     launch = figures.get("launch")
     if launch:
         lines.append("launch to first scan                  %6.2f s (simulator ready at %s s)" % (
@@ -482,6 +529,9 @@ def main(argv=None):
                                              args.clock_hz, args.seconds, args.check_seconds)
         loops["lockstep"] = measure_loop(session, listener, "lockstep", True, args.clock_hz,
                                          args.seconds, args.check_seconds)
+        loops["lockstep + listeners"] = measure_loop(
+            session, listener, "lockstep + listeners", True, args.clock_hz, args.seconds,
+            args.check_seconds, watchers=True)
         if args.clock_hz != SIMULATOR_DEFAULT_CLOCK_HZ:
             loops["lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ] = measure_loop(
                 session, listener, "lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ, True,

@@ -58,7 +58,8 @@ GAZEBO_PUBLICATIONS = {t["name"]: t["type"] for t in GAZEBO_API["topics"]
 PUBLICATIONS = dict(GAZEBO_PUBLICATIONS, **{
     "/m2wr/laser/scan": "sensor_msgs/LaserScan",     # m2wr's laser topicName
     "/odom": "nav_msgs/Odometry",                      # its odometryTopic
-    "/tf": "tf2_msgs/TFMessage"})                      # odom -> link_chassis
+    "/tf": "tf2_msgs/TFMessage",                       # odom -> link_chassis
+    "/joint_states": "sensor_msgs/JointState"})        # its wheels, for rviz
 ROSPY_PUBLICATIONS = {"/rosout": "rosgraph_msgs/Log"}
 SUBSCRIPTIONS = {"/cmd_vel": "geometry_msgs/Twist",   # m2wr's commandTopic
                  "/gazebo/set_model_state": "gazebo_msgs/ModelState",

@@ -212,9 +212,13 @@ def test_huge_command_is_clamped_and_the_robot_stays_finite_and_out_of_obstacles
     for _ in range(int(4.0 / STEP)):
         for reading in world.step():
             data = reading.data
-            values = data.ranges if hasattr(data, "ranges") else \
-                np.concatenate([data.pose.position, data.pose.orientation, data.linear,
-                                data.angular])
+            if hasattr(data, "ranges"):
+                values = data.ranges
+            elif hasattr(data, "positions"):             # the wheels' joint states
+                values = np.concatenate([data.positions, data.velocities])
+            else:
+                values = np.concatenate([data.pose.position, data.pose.orientation, data.linear,
+                                         data.angular])
             assert not np.any(np.isnan(values))
         pose = world.model_pose("m2wr")
         assert all(math.isfinite(v) for v in pose.position + pose.orientation)

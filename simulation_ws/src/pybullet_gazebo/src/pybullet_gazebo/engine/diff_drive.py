@@ -15,7 +15,9 @@ Plugin parameters, read as Noetic reads them (default in brackets):
   commandTopic [cmd_vel], odometryTopic [odom], odometryFrame [odom],
   robotBaseFrame [base_footprint], odometrySource [world | encoder]
   publishTf [true]           false: Noetic publishes no odometry at all (due() stays false)
-  publishOdomTF [true], publishWheelTF [false], publishWheelJointState [false]
+  publishOdomTF [true], publishWheelTF [false], publishWheelJointState [false: the
+                             stand-in publishes the wheel joint states whatever it says,
+                             see joint_states.py]
   legacyMode                 removed in Melodic (gazebo_ros_pkgs #707) and not read by Noetic:
                              `true` only draws a warning, unless the component is built with
                              legacy_mode_swaps=True to emulate Kinetic and older, where
@@ -52,6 +54,8 @@ from .part import Part, PartContext
 from .transforms import Pose, cross
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
+HOLD_SLACK = 0.01            # [rad] a stopped wheel turned further than this is held anew
+HOLD_GAIN = 0.1              # Bullet's position gain (fraction of the angle error per step)
 
 
 @dataclass
@@ -123,7 +127,7 @@ class DiffDrive(Part):
         self.wheel_acceleration = number("wheelAcceleration", 0.0, minimum=0.0)     # [m/s^2]
         self.wheel_torque = number("wheelTorque", 5.0, minimum=0.0)                 # [N m]
         self.update_rate = number("updateRate", 100.0)                              # [Hz]
-        for tag in ("publishWheelTF", "publishWheelJointState"):
+        for tag in ("publishWheelTF",):     # publishWheelJointState: see joint_states.py
             if boolean(tag, False):
                 self._warn_once("%s: <%s>true is not simulated by the stand-in; ignored"
                                 % (where, tag))
@@ -209,6 +213,7 @@ class DiffDrive(Part):
         self._control.last = None
         self._publish.last = None
         self._rim_speed = [0.0, 0.0]                       # [m/s] last applied, per wheel
+        self._held = [None, None]                          # [rad] where a stopped wheel stays
         self._encoder = [0.0, 0.0, 0.0]                    # x [m], y [m], heading [rad]
         self._encoder_twist = (0.0, 0.0)                   # [m/s], [rad/s]
         self._encoder_time = None
@@ -239,16 +244,38 @@ class DiffDrive(Part):
         self._apply(self._rim_speed[0] / self.wheel_radius, self._rim_speed[1] / self.wheel_radius)
 
     def _apply(self, left, right):
-        """Drive (leftJoint, rightJoint) at these speeds [rad/s], within their limits."""
-        for (index, name, limit), speed in zip(self._joints, (left, right)):
+        """Drive (leftJoint, rightJoint) at these speeds [rad/s], within their limits; a
+        wheel told to stop is held where it stopped (see _hold)."""
+        for slot, ((index, name, limit), speed) in enumerate(zip(self._joints, (left, right))):
             if abs(speed) > limit:
                 self._warn_once(("clamped", name),
                                 "diff drive '%s': wheel speed %.4g rad/s for joint '%s' is over "
                                 "its URDF velocity limit %.4g rad/s; clamped (reported once)"
                                 % (self.name, speed, name, limit))
                 speed = math.copysign(limit, speed)
+            if speed == 0.0:
+                self._hold(slot, index)
+                continue
+            self._held[slot] = None
             self._client.setJointMotorControl2(self.body_id, index, pybullet.VELOCITY_CONTROL,
                                                targetVelocity=speed, force=self.wheel_torque)
+
+    def _hold(self, slot, index):
+        """A zero speed target, without Bullet's creep. Bullet's velocity motor leaves a
+        residual error (its iterative solver does not converge under the robot's weight:
+        m2wr rolled backwards at 6e-5 m/s with a zero command, 0.2 m per hour); ODE's motor
+        in Gazebo holds the wheel. The same motor, same force limit, also pulls the joint
+        back to the angle where it stopped, which cancels that residual. A wheel turned
+        further than HOLD_SLACK from it (pushed against the torque limit, or a teleport that
+        zeroed the joints) is held where it now is: no spring back."""
+        angle = self._client.getJointState(self.body_id, index)[0]
+        held = self._held[slot]
+        if held is None or abs(angle - held) > HOLD_SLACK:
+            held = self._held[slot] = angle
+        self._client.setJointMotorControl2(self.body_id, index, pybullet.POSITION_CONTROL,
+                                           targetPosition=held, targetVelocity=0.0,
+                                           positionGain=HOLD_GAIN, velocityGain=1.0,
+                                           force=self.wheel_torque)
 
     def _integrate_encoder(self, sim_time):
         """Noetic's encoder odometry: dead reckoning from the wheel joints' speeds."""

@@ -4,11 +4,13 @@ name at spawn (robot_loader's job), never silently ignored. The ROS adapter's bi
 (ros/bindings.py) are keyed by the same KEYs.
 """
 from .diff_drive import DiffDrive
+from .joint_states import JointStatePublisher
 from .ray_sensor import RaySensor
 
 # <gazebo><plugin filename="..."> -> Part class
 PLUGIN_PARTS = {
     DiffDrive.KEY: DiffDrive,
+    JointStatePublisher.KEY: JointStatePublisher,
 }
 
 # <gazebo reference="link"><sensor type="..."> -> Part class

@@ -9,7 +9,9 @@ import tempfile
 import pybullet
 
 from . import wheel_contact
+from .diff_drive import DiffDrive
 from .entities import Robot
+from .joint_states import JointStatePublisher
 from .part import PartContext
 from .registry import PLUGIN_PARTS, SENSOR_PARTS, SENSOR_PLUGINS
 from .robot_description import (DEFAULT_MU, bullet_tree, driven_wheel_links,
@@ -76,6 +78,10 @@ def make_robot(client, body, spec: RobotSpec, pose, namespace, contacts, caster,
                  % (spec.name, plugin.name, plugin.filename))
             continue
         robot.parts.append(_build(part_class, context, plugin))
+    if not any(isinstance(p, JointStatePublisher) for p in robot.parts):
+        # the drive's wheel joint states, for rviz (see joint_states.py)
+        for drive in [p for p in robot.parts if isinstance(p, DiffDrive)]:
+            robot.parts.append(JointStatePublisher.for_wheels(context, drive))
     for sensor in spec.sensors:
         if sensor.link not in links:
             raise SpawnError("model '%s': sensor '%s' is on link '%s', which the URDF does "

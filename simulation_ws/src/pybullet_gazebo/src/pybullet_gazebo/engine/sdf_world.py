@@ -63,6 +63,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import replace
 
 from . import mesh_files
+from .appearance import sdf_link_colour
 from .specs import (Box, CollisionSpec, Cylinder, InertialSpec, LinkSpec, Mesh, ModelSpec,
                     PhysicsSpec, Plane, Sphere, TriangleMesh, WorldSpec)
 from .transforms import Pose
@@ -405,7 +406,7 @@ class _WorldReader:
                     else InertialSpec())
         self.check_rest(elem, {"pose", "inertial", "collision"}, owner, where)
         return LinkSpec(name=name, pose=self.pose(elem, owner), inertial=inertial,
-                        collisions=tuple(collisions))
+                        collisions=tuple(collisions), colour=sdf_link_colour(elem))
 
     def inertial(self, elem, owner, where):
         default = InertialSpec()

@@ -76,6 +76,7 @@ class LinkSpec:
     pose: Pose = Pose()                       # in the model frame
     inertial: InertialSpec = InertialSpec()
     collisions: Tuple[CollisionSpec, ...] = ()
+    colour: Optional[Tuple[float, float, float, float]] = None   # RGBA of its visual, GUI only
 
 
 @dataclass(frozen=True)

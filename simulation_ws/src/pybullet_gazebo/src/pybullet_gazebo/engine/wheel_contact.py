@@ -26,6 +26,12 @@ CONTACT_MASS = 1e-3            # [kg] negligible next to the wheel's
 # A real tyre's contact patch resists twisting about the vertical; a point contact does not,
 # and a robot at rest would creep round (0.03 deg/s). A small torsional friction stops it.
 SPINNING_FRICTION = 0.001      # [m] Bullet's spinning-friction lever
+# Bullet's friction is a velocity constraint: what its iterative solver leaves unsolved each
+# step adds up, and a robot at rest slid sideways at 5e-7 m/s. A friction anchor also pulls
+# the contact back to where it started sticking (a position correction), as a tyre that does
+# not slip stays put: the drift falls to 1e-11 m/s (the drive's wheel hold does the same for
+# rolling, see diff_drive._hold).
+FRICTION_ANCHOR = 1
 
 
 def add_contact_links(root, wheel_links):
@@ -67,7 +73,7 @@ def apply_groups(client, body, links, contacts):
         client.setCollisionFilterGroupMask(body, links[contact], CONTACT, GROUND)
         wheel_friction = client.getDynamicsInfo(body, links[wheel])[1]   # the wheel's mu
         client.changeDynamics(body, links[contact], lateralFriction=wheel_friction,
-                              spinningFriction=SPINNING_FRICTION)
+                              spinningFriction=SPINNING_FRICTION, frictionAnchor=FRICTION_ANCHOR)
 
 
 def mark_ground(client, body):

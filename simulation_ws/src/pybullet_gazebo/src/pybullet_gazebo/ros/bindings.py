@@ -5,6 +5,8 @@ step's sim time, and closes them when the robot goes. A part whose KEY has no bi
 reported by name when its robot is bound.
 
   ray (libgazebo_ros_laser.so)      publishes the plugin's topicName (sensor_msgs/LaserScan)
+  libgazebo_ros_joint_state_publisher.so  publishes joint_states (sensor_msgs/JointState),
+                                    also for every diff drive's wheels (engine/joint_states.py)
   libgazebo_ros_diff_drive.so       subscribes commandTopic (geometry_msgs/Twist), publishes
                                     odometryTopic (nav_msgs/Odometry) and TF odometryFrame ->
                                     robotBaseFrame on /tf, each only while someone listens
@@ -20,12 +22,14 @@ from typing import Callable, Dict, List
 import rospy
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import JointState, LaserScan
 from tf2_msgs.msg import TFMessage
 
 from pybullet_gazebo.engine.diff_drive import DiffDrive
+from pybullet_gazebo.engine.joint_states import JointStatePublisher
 from pybullet_gazebo.engine.ray_sensor import RaySensor
 from pybullet_gazebo.ros import conversions, robot_namespace
+from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 
 
 @dataclass
@@ -74,7 +78,7 @@ class Binding:
 class LaserBinding(Binding):
     def __init__(self, robot, part, context):
         super().__init__(robot, part, context)
-        self.scans = rospy.Publisher(self.topic(part.topic), LaserScan, queue_size=1)
+        self.scans = DirectPublisher(self.topic(part.topic), LaserScan)   # see its docstring
         self.publishers.append(self.scans)
         self.frame_id = self.frame(part.frame_id, fall_back_to_namespace=False)
 
@@ -126,10 +130,30 @@ class DriveBinding(Binding):
         return False
 
 
+class JointStateBinding(Binding):
+    """joint_states (sensor_msgs/JointState) in the robot's namespace, built only while
+    someone listens (robot_state_publisher, rviz)."""
+
+    def __init__(self, robot, part, context):
+        super().__init__(robot, part, context)
+        self.states = DirectPublisher(self.topic("joint_states"), JointState)
+        self.publishers.append(self.states)
+        self.message = JointState(name=list(part.names))
+
+    def publish(self, data, stamp):
+        if self.states.get_num_connections() > 0:
+            self.message.header.stamp = stamp
+            self.message.position = data.positions
+            self.message.velocity = data.velocities
+            self.states.publish(self.message)
+        return False
+
+
 # part KEY -> its ROS binding
 BINDINGS: Dict[str, type] = {
     RaySensor.KEY: LaserBinding,
     DiffDrive.KEY: DriveBinding,
+    JointStatePublisher.KEY: JointStateBinding,
 }
 
 

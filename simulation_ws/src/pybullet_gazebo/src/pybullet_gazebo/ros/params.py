@@ -12,7 +12,11 @@ parameters (~name), with units:
   lockstep            after each scan, wait for the controller's cmd_vel (see README)
   lockstep_timeout    [s] of wall time to wait for it before stepping on
   cmd_vel_timeout     [s] of sim time after which a robot stops without commands; 0 = never
-  gui                 open pybullet's GUI window (needs a display)
+  gui                 open a window showing the world (needs a display; else headless)
+  gui_fps             [Hz wall] at most this many frames per second in that window
+  gui_rays            laser beams drawn: sdf (as the sensor's <visualize>, Gazebo's rule),
+                      true (every ray sensor) or false
+  gui_follow          the window's camera follows the robot from the start (key f toggles)
   debug               log at debug level
   legacy_mode         true: diff drives as Kinetic's with <legacyMode>true whatever the URDF
                       says (m2wr turns counter-clockwise for a positive angular.z, as the
@@ -44,6 +48,9 @@ class SimulatorParams:
     lockstep_timeout: float = 1.0           # [s] wall
     cmd_vel_timeout: float = 0.0            # [s] sim
     gui: bool = False
+    gui_fps: float = 30.0                   # [Hz] wall
+    gui_rays: str = "sdf"                   # sdf | true | false
+    gui_follow: bool = False
     debug: bool = False
     legacy_mode: bool = False
     contacts: bool = False
@@ -67,6 +74,9 @@ class SimulatorParams:
             lockstep_timeout=read.number("lockstep_timeout", d.lockstep_timeout, above=0.0),
             cmd_vel_timeout=read.number("cmd_vel_timeout", d.cmd_vel_timeout, minimum=0.0),
             gui=read.boolean("gui", d.gui),
+            gui_fps=read.number("gui_fps", d.gui_fps, above=0.0),
+            gui_rays=_gui_rays(read, d.gui_rays),
+            gui_follow=read.boolean("gui_follow", d.gui_follow),
             debug=read.boolean("debug", d.debug),
             legacy_mode=read.boolean("legacy_mode", d.legacy_mode),
             contacts=read.boolean("contacts", d.contacts),
@@ -78,3 +88,12 @@ class SimulatorParams:
         return SimulatorParams.from_values(rospy.get_param("~", {}),
                                            rospy.get_param("/use_sim_time", True),
                                            where=rospy.get_name())
+
+
+def _gui_rays(read, default):
+    """~gui_rays: sdf, true or false (roslaunch hands true/false over as booleans)."""
+    raw = read.values.get("gui_rays")
+    value = default if raw is None else str(raw).strip().lower()
+    if value not in ("sdf", "true", "false"):
+        raise ParameterError("~gui_rays = %r is invalid: expected sdf, true or false" % raw)
+    return value

@@ -31,8 +31,10 @@ from tf2_msgs.msg import TFMessage
 from pybullet_utils.bullet_client import BulletClient
 
 from pybullet_gazebo.engine.world import World
+from pybullet_gazebo.gui.window import open_window
 from pybullet_gazebo.ros import conversions
 from pybullet_gazebo.ros.bindings import BindingContext, RobotBindings
+from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
 from pybullet_gazebo.ros.state_topics import StateTopics
@@ -45,18 +47,17 @@ class SimulatorNode:
     def __init__(self, params, world_spec, model_path=()):
         self.params = params
         self.model_path = list(model_path)        # for spawn_sdf_model's model:// includes
-        show_gui = params.gui and bool(os.environ.get("DISPLAY"))
-        if params.gui and not show_gui:
-            rospy.loginfo("gui requested but there is no display (DISPLAY is unset): running "
-                          "headless; pass gui:=false to silence this")
-        self.gui = show_gui
-        mode = pybullet.GUI if show_gui else pybullet.DIRECT
-        self.client = BulletClient(connection_mode=mode)
+        # Physics always in DIRECT mode; the window is a viewer process of its own (gui/)
+        self.client = BulletClient(connection_mode=pybullet.DIRECT)
         step = params.max_step_size or world_spec.physics.max_step_size
         self.world = World(self.client, world_spec, step, seed=params.seed,
                            warn=lambda m: rospy.logwarn(m),
                            command_timeout=params.cmd_vel_timeout,
                            legacy_mode=params.legacy_mode)
+        self.window = open_window(self.world, fps=params.gui_fps, rays=params.gui_rays,
+                                  follow=params.gui_follow, info=rospy.loginfo,
+                                  warn=rospy.logwarn) if params.gui else None
+        self.gui = self.window is not None
         self.lock = threading.RLock()             # guards the world: loop vs. service threads
         self.paused = params.paused
         world_rtf = world_spec.physics.real_time_factor
@@ -80,8 +81,7 @@ class SimulatorNode:
         self._last_clock_step = 0
         self._model_states_every = self._steps_per_period(params.model_states_rate)
 
-        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) \
-            if params.use_sim_time else None
+        self.clock_pub = DirectPublisher("/clock", Clock) if params.use_sim_time else None
         self.state_topics = StateTopics(self.world)
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100,
                                             latch=True) if params.contacts else None
@@ -113,12 +113,16 @@ class SimulatorNode:
         with self.lock:
             robot = self.world.spawn_urdf(name, urdf_xml, pose, namespace=namespace)
             self._bindings[robot.name] = RobotBindings(robot, self._binding_context)
+            if self.window is not None:
+                self.window.add_robot(robot, urdf_xml)
         return robot
 
     def delete_model(self, name):
         with self.lock:
             self.world.delete_model(name)
             bindings = self._bindings.pop(name, None)
+            if self.window is not None:
+                self.window.remove_robot(name)
         if bindings is not None:
             bindings.close()
 
@@ -172,6 +176,8 @@ class SimulatorNode:
                 commands_before = self.lockstep.commands
                 now = self.world.sim_time
                 scans = self._publish(readings)
+                if self.window is not None:
+                    self.window.after_step(readings)      # a frame at most gui_fps per second
                 needed_at = self.world.next_command_time() if scans else None
             # The drive reads its command only at its next update (Gazebo's plugin does the
             # same), so physics runs on until then while the controller thinks.
@@ -241,7 +247,10 @@ class SimulatorNode:
             self._disconnect()
 
     def _disconnect(self):
-        try:
-            self.client.disconnect()
-        except pybullet.error:
-            pass
+        if self.window is not None:
+            self.window.close()
+        with self.lock:           # a service thread still inside the world finishes first
+            try:
+                self.client.disconnect()
+            except pybullet.error:
+                pass
