@@ -74,7 +74,13 @@ def run_window(tmp_path, world, urdf, rays, seconds=1.0):
     next(p for p in robot.parts if isinstance(p, DiffDrive)).set_command(0.5, 0.0)
     deadline = time.monotonic() + seconds
     while time.monotonic() < deadline:
-        window.after_step(world.step())
+        # 2 s of sim time at most (1 m of driving, still in the corridor), however fast the
+        # machine steps; frames keep coming at the window's own wall-clock rate
+        if world.sim_time < 2.0:
+            window.after_step(world.step())
+        else:
+            time.sleep(0.005)
+            window.after_step([])
     time.sleep(0.3)                       # the writer thread's last frame
     window.close()
     return recorded(record), notes

@@ -19,7 +19,6 @@ source (see nodes/gazebo_world).
 Parameters: see params.py. All messages of one step carry that step's sim time; wall-clock
 pacing (real_time_factor, lockstep: pacing.py) lives in the adapter, never in the engine.
 """
-import os
 import threading
 import time
 
