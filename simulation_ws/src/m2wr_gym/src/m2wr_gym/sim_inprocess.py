@@ -1,0 +1,112 @@
+"""The stand-in's engine in this process, as the environments drive it: no ROS master, the
+same world loading, laser, diff drive and contacts as the ROS simulator (pybullet_gazebo's
+World), stepped at its fixed physics step (5 ms, the simulator's default).
+
+Each reset builds the World afresh (about 30 ms for world02) and spawns m2wr at the start
+pose resting on its wheels: Bullet keeps contact caches across teleports, so a rebuilt world
+is what makes an episode depend on its seed and actions only.
+"""
+from dataclasses import dataclass
+import math
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pybullet
+from pybullet_utils.bullet_client import BulletClient
+
+from pybullet_gazebo.engine.transforms import Pose
+from pybullet_gazebo.engine.world import SpawnError, World
+
+from . import resources
+
+ROBOT = "m2wr"
+REST_Z = 0.1            # [m] link_chassis height when m2wr stands on its wheels (wheel radius)
+
+
+@dataclass
+class Snapshot:
+    """What the robot senses and where it is after a step."""
+    ranges: np.ndarray        # (720,) float32 [m], +inf = no return
+    range_max: float          # [m]
+    x: float                  # [m] model frame (link_chassis) in the world
+    y: float                  # [m]
+    yaw: float                # [rad]
+    sim_time: float           # [s]
+    touched: tuple = ()       # names of the models touched during the step (ground excluded)
+
+
+def robot_urdf(laser_noise=None):
+    """m2wr's URDF; laser_noise [m] replaces the laser's Gaussian stddev (None: as written)."""
+    text = resources.robot_urdf()
+    if laser_noise is None:
+        return text
+    root = ET.fromstring(text)
+    for stddev in root.iter("stddev"):
+        stddev.text = repr(float(laser_noise))
+    return ET.tostring(root, encoding="unicode")
+
+
+class InProcessSim:
+    def __init__(self, world_path, physics_step=0.005, laser_noise=None, gui=False):
+        self.spec = resources.world_spec(world_path)
+        self.physics_step = physics_step          # [s]
+        self.urdf = robot_urdf(laser_noise)
+        self.warnings = []
+        self.client = BulletClient(connection_mode=pybullet.GUI if gui else pybullet.DIRECT)
+        if gui:
+            self.client.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0)
+        self.world = None
+        self._drive = None
+        self._laser_last = None
+
+    def reset(self, x, y, yaw, seed):
+        """A fresh world with m2wr at (x, y, yaw) at rest; ValueError naming the pose when it
+        is inside an obstacle. Returns the first scan (taken at sim time 0)."""
+        self.world = World(self.client, self.spec, self.physics_step, seed=seed,
+                           warn=self.warnings.append)
+        pose = Pose.from_xyz_rpy(x, y, REST_Z, 0.0, 0.0, yaw)
+        try:
+            robot = self.world.spawn_urdf(ROBOT, self.urdf, pose)
+        except SpawnError as err:
+            raise ValueError("start pose (x=%.3f, y=%.3f, yaw=%.3f): %s" % (x, y, yaw, err)) \
+                from None
+        drives = [c for c in robot.components if hasattr(c, "set_command")]
+        lasers = [c for c in robot.components if hasattr(c, "measure")]
+        if len(drives) != 1 or len(lasers) != 1:
+            raise RuntimeError("m2wr should have one drive and one laser; it has %d and %d"
+                               % (len(drives), len(lasers)))
+        self._drive = drives[0]
+        self._laser_last = None
+        readings = self.world.step()           # the laser's first scan is due at once
+        return self._snapshot(readings, ())
+
+    def run(self, linear_x, angular_z, steps):
+        """Sets the drive's command and steps physics `steps` times; the command reaches the
+        wheels at the drive's next update (20 Hz for m2wr), as a cmd_vel would."""
+        self._drive.set_command(linear_x, angular_z)
+        touched = set()
+        readings = []
+        for _ in range(steps):
+            readings.extend(self.world.step())
+            for _, other in self.world.touching():
+                touched.add(other)
+        return self._snapshot(readings, tuple(sorted(touched)))
+
+    def _snapshot(self, readings, touched):
+        for reading in readings:
+            if hasattr(reading.data, "ranges"):
+                self._laser_last = reading.data
+        scan = self._laser_last
+        pose = self.world.model_pose(ROBOT)
+        yaw = pose.rpy[2] if not callable(pose.rpy) else pose.rpy()[2]
+        return Snapshot(np.array(scan.ranges, dtype=np.float32), float(scan.range_max),
+                        float(pose.position[0]), float(pose.position[1]), float(yaw),
+                        float(self.world.sim_time), touched)
+
+    def close(self):
+        if self.client is not None:
+            try:
+                self.client.disconnect()
+            except pybullet.error:
+                pass
+            self.client = None
