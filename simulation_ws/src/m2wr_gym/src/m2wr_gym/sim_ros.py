@@ -1,0 +1,221 @@
+"""A running simulator driven in lockstep over ROS, with the interface of sim_inprocess:
+what the environments use when backend="ros" (ids M2wrAvoidRos-v0, M2wrGoalRos-v0).
+
+Needs a master and the stand-in started with lockstep, e.g.
+    roslaunch my_worlds launch_world.launch world:=world02 gui:=false real_time_factor:=0 lockstep:=true
+m2wr is spawned if it is not in the world (with laser_noise when given).
+
+Per environment step (exact: each step is dt of sim time and the action reaches the drive at
+the same sim time as in process):
+  publish the action on /cmd_vel, /gazebo/unpause_physics, answer every intermediate scan of
+  /m2wr/laser/scan with the same command (lockstep waits for an answer to each scan before the
+  drive's next update), take the scan stamped dt after the last one as the observation, then
+  /gazebo/pause_physics, so the agent may think as long as it likes (lockstep alone would step
+  on after lockstep_timeout).
+Reset: pause, /gazebo/reset_simulation (sim time 0), /gazebo/set_model_state to the start
+pose, unpause, take the first scan (stamped one physics step), pause.
+The pose is /odom's (the drive's odometrySource world: the true pose), published at the
+drive's updates, one physics step (5 ms) before each scan; contacts come from
+/gazebo/contacts. The laser noise follows the simulator's own `seed`, not reset(seed=...).
+"""
+import math
+import queue
+import threading
+
+import numpy as np
+
+from .sim_inprocess import REST_Z, ROBOT, Snapshot, robot_urdf
+
+SCAN_TOPIC = "/m2wr/laser/scan"
+COMMAND_TOPIC = "/cmd_vel"
+ODOM_TOPIC = "/odom"
+CONTACTS_TOPIC = "/gazebo/contacts"
+_SLACK = 1e-6               # [s] stamps are whole nanoseconds of whole physics steps
+
+
+class RosSimError(RuntimeError):
+    pass
+
+
+class RosSim:
+    def __init__(self, world_path, physics_step=0.005, laser_noise=None, timeout=30.0):
+        import rospy
+        from geometry_msgs.msg import Twist
+        from gazebo_msgs.msg import ContactsState
+        from nav_msgs.msg import Odometry
+        from sensor_msgs.msg import LaserScan
+        from std_srvs.srv import Empty
+        from gazebo_msgs.srv import (GetPhysicsProperties, GetWorldProperties, SetModelState,
+                                     SpawnModel)
+        self._rospy, self._Twist = rospy, Twist
+        self.physics_step = physics_step
+        self.timeout = timeout                         # [s] wall, for each answer awaited
+        if not rospy.core.is_initialized():
+            rospy.init_node("m2wr_gym_env", anonymous=True, disable_signals=True)
+        try:
+            rospy.wait_for_service("/gazebo/reset_simulation", timeout=timeout)
+        except rospy.ROSException:
+            raise RosSimError("no simulator answers /gazebo/reset_simulation within %g s; start "
+                              "one: roslaunch my_worlds launch_world.launch gui:=false "
+                              "real_time_factor:=0 lockstep:=true" % timeout) from None
+        if not rospy.get_param("/gazebo/lockstep", False):
+            raise RosSimError("the simulator runs without lockstep, so steps would not be exact;"
+                              " start it with lockstep:=true")
+        call = lambda name, kind: rospy.ServiceProxy("/gazebo/" + name, kind, persistent=True)
+        self._pause, self._unpause = call("pause_physics", Empty), call("unpause_physics", Empty)
+        self._reset_sim = call("reset_simulation", Empty)
+        self._set_state = call("set_model_state", SetModelState)
+        step = call("get_physics_properties", GetPhysicsProperties)().time_step
+        if abs(step - physics_step) > 1e-9:
+            raise RosSimError("the simulator's physics step is %g s, the environment's "
+                              "physics_step %g s; pass physics_step=%g" % (step, physics_step, step))
+        models = call("get_world_properties", GetWorldProperties)().model_names
+        if ROBOT not in models:
+            spawn = rospy.ServiceProxy("/gazebo/spawn_urdf_model", SpawnModel)
+            from geometry_msgs.msg import Pose as PoseMsg
+            pose = PoseMsg()
+            pose.position.z = REST_Z
+            pose.orientation.w = 1.0
+            answer = spawn(ROBOT, robot_urdf(laser_noise), "", pose, "world")
+            if not answer.success:
+                raise RosSimError("could not spawn m2wr: %s" % answer.status_message)
+        elif laser_noise is not None:
+            rospy.logwarn("m2wr_gym: m2wr is already in the simulator; laser_noise=%s is not "
+                          "applied (its URDF's noise is)", laser_noise)
+        self._scans = queue.Queue()
+        self._lock = threading.Lock()
+        self._odom = None
+        self._contacts = []                     # (stamp, touching names) as published
+        self._cmd = rospy.Publisher(COMMAND_TOPIC, Twist, queue_size=10)
+        self._subs = [
+            rospy.Subscriber(SCAN_TOPIC, LaserScan, self._scans.put, queue_size=100),
+            rospy.Subscriber(ODOM_TOPIC, Odometry, self._on_odom, queue_size=100),
+            rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self._on_contacts, queue_size=100),
+        ]
+        self._wait_for_connections()
+        self._command = (0.0, 0.0)
+        self._time = None
+
+    def _wait_for_connections(self):
+        import time
+        deadline = time.monotonic() + self.timeout
+        while self._cmd.get_num_connections() == 0 or \
+                any(s.get_num_connections() == 0 for s in self._subs[:2]):
+            if time.monotonic() > deadline:
+                raise RosSimError("no connection on %s / %s / %s within %g s"
+                                  % (COMMAND_TOPIC, SCAN_TOPIC, ODOM_TOPIC, self.timeout))
+            time.sleep(0.02)
+
+    def _on_odom(self, msg):
+        with self._lock:
+            self._odom = msg
+
+    def _on_contacts(self, msg):
+        names = tuple(sorted({s.collision2_name for s in msg.states}))
+        with self._lock:
+            self._contacts.append((msg.header.stamp.to_sec(), names))
+
+    def _publish(self, command):
+        msg = self._Twist()
+        msg.linear.x, msg.angular.z = command
+        self._cmd.publish(msg)
+
+    def _next_scan(self, stamp_wanted):
+        """Waits for the scan stamped `stamp_wanted` [s]; answers earlier ones with the
+        current command (lockstep needs an answer to each), drops stale ones."""
+        while True:
+            try:
+                msg = self._scans.get(timeout=self.timeout)
+            except queue.Empty:
+                raise RosSimError("no scan stamped %.3f s on %s within %g s of wall time"
+                                  % (stamp_wanted, SCAN_TOPIC, self.timeout)) from None
+            stamp = msg.header.stamp.to_sec()
+            if abs(stamp - stamp_wanted) <= _SLACK:
+                return msg
+            if stamp < stamp_wanted and self._time is not None and stamp > self._time + _SLACK:
+                self._publish(self._command)     # an intermediate scan of this step
+            # else: a scan from before the reset, still in the queue
+
+    def reset(self, x, y, yaw, seed=None):
+        from gazebo_msgs.msg import ModelState
+        self._pause()
+        self._reset_sim()
+        state = ModelState()
+        state.model_name = ROBOT
+        state.pose.position.x, state.pose.position.y, state.pose.position.z = x, y, REST_Z
+        state.pose.orientation.z, state.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+        state.reference_frame = "world"
+        answer = self._set_state(state)
+        if not answer.success:
+            raise RosSimError("set_model_state failed: %s" % answer.status_message)
+        with self._lock:
+            self._contacts = [(0.0, ())]
+            self._odom = None
+        self._command = (0.0, 0.0)
+        self._time = None
+        self._unpause()
+        msg = self._next_scan(self.physics_step)
+        self._pause()
+        self._time = msg.header.stamp.to_sec()
+        return self._snapshot(msg, (), start=(x, y, yaw))
+
+    def run(self, linear_x, angular_z, steps):
+        start = self._time
+        self._command = (float(linear_x), float(angular_z))
+        self._publish(self._command)            # the answer to the last observation's scan
+        self._unpause()
+        msg = self._next_scan(start + steps * self.physics_step)
+        self._pause()
+        self._time = msg.header.stamp.to_sec()
+        with self._lock:
+            touched = set()
+            current = ()
+            for stamp, names in self._contacts:
+                if stamp <= start + _SLACK:
+                    current = names
+                elif stamp <= self._time + _SLACK:
+                    touched.update(names)
+            touched.update(current)
+            self._contacts = [(start, ())] + [c for c in self._contacts if c[0] > self._time]
+            self._contacts[0] = (self._time, self._contacts_now(self._time))
+        return self._snapshot(msg, tuple(sorted(touched)))
+
+    def _contacts_now(self, stamp):
+        names = ()
+        for t, n in self._contacts:
+            if t <= stamp + _SLACK:
+                names = n
+        return names
+
+    def _snapshot(self, msg, touched, start=None):
+        import time
+        if start is not None:
+            x, y, yaw = start
+        else:
+            deadline = time.monotonic() + self.timeout
+            while True:
+                with self._lock:
+                    odom = self._odom
+                if odom is not None and odom.header.stamp.to_sec() >= \
+                        msg.header.stamp.to_sec() - self.physics_step - _SLACK:
+                    break
+                if time.monotonic() > deadline:
+                    raise RosSimError("no /odom for sim time %.3f s" % msg.header.stamp.to_sec())
+                time.sleep(0.001)
+            p, q = odom.pose.pose.position, odom.pose.pose.orientation
+            x, y = p.x, p.y
+            yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+        ranges = np.array(msg.ranges, dtype=np.float32)
+        return Snapshot(ranges, float(msg.range_max), float(x), float(y), float(yaw),
+                        msg.header.stamp.to_sec(), touched)
+
+    def close(self):
+        for sub in getattr(self, "_subs", []):
+            sub.unregister()
+        if getattr(self, "_cmd", None) is not None:
+            try:
+                self._publish((0.0, 0.0))
+            except Exception:
+                pass
+            self._cmd.unregister()
+            self._cmd = None

@@ -1,0 +1,222 @@
+"""Train a policy with stable-baselines3 (PPO, or DQN) and export it as a numpy .npz that the
+ROS node motion_plan/learned_avoidance.py runs (see policy.py). Run through scripts/train.sh,
+which installs the training extra (requirements-train.txt: torch CPU, stable-baselines3) on
+first use.
+
+    scripts/train.sh                                  # avoid, world02, PPO, 2 envs
+    scripts/train.sh --timesteps 20000 --out /tmp/x   # a quick try
+
+Prints progress every --report-every timesteps (episodes, mean return and length, env steps
+per second, time left); writes OUT/policy.npz, OUT/learning_curve.png, OUT/model.zip (the
+SB3 model, to go on training) and OUT/N.monitor.csv (one row per episode per environment).
+Observations are multiplied by 1/10 before the network (obs_scale in the .npz), so the
+network sees values in [0, 1].
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(prog="scripts/train.sh", description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--task", default="avoid", choices=("avoid", "goal"))
+    p.add_argument("--world", default="world02", help="world01, world02 or a .world path")
+    p.add_argument("--algo", default="ppo", choices=("ppo", "dqn"))
+    p.add_argument("--timesteps", type=int, default=300000, help="environment steps in all")
+    p.add_argument("--envs", type=int, default=2, help="environments in subprocesses (1: in "
+                   "this process)")
+    p.add_argument("--observation", default="regions", choices=("regions", "scan"))
+    p.add_argument("--downsample", type=int, default=1)
+    p.add_argument("--episode-seconds", type=float, default=60.0,
+                   help="sim time of a training episode [s]")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--hidden", type=int, nargs="+", default=[64, 64], help="MLP layer sizes")
+    p.add_argument("--out", default=os.path.join(os.environ.get("M2WR_ROOT", "."), "output",
+                                                 "train"), help="output folder")
+    p.add_argument("--report-every", type=int, default=10000, help="timesteps between lines")
+    args = p.parse_args(argv)
+    if args.timesteps < 1 or args.envs < 1:
+        p.error("--timesteps and --envs must be >= 1")
+    return args
+
+
+def env_kwargs(args):
+    """Training episodes start from free poses drawn anew each episode (so the policy does
+    not learn one path), discrete actions (forward / left / right)."""
+    kwargs = dict(task=args.task, world=args.world, start="random", observation=args.observation,
+                  action="discrete", max_episode_seconds=args.episode_seconds)
+    if args.observation == "scan":
+        kwargs["downsample"] = args.downsample
+    return kwargs
+
+
+OBS_SCALE = 0.1          # [1/m]
+
+
+def make_env(kwargs, monitor_path=None):
+    def build():
+        import gymnasium
+        from gymnasium.wrappers import TransformObservation
+        from stable_baselines3.common.monitor import Monitor
+        import m2wr_gym  # noqa: F401  (registers the ids)
+        env = gymnasium.make("m2wr_gym:M2wrAvoid-v0", **kwargs)
+        space = env.observation_space
+        scaled = type(space)(space.low * OBS_SCALE, space.high * OBS_SCALE, dtype=space.dtype)
+        env = TransformObservation(env, lambda o: (o * OBS_SCALE).astype(np.float32), scaled)
+        return Monitor(env, monitor_path)
+    return build
+
+
+def export(model, kwargs, args, dt, path):
+    """The SB3 model's deterministic policy as a NumpyPolicy .npz (argmax of the logits)."""
+    import torch
+    from . import actions
+    from .policy import NumpyPolicy
+    layers = []
+    if args.algo == "ppo":
+        modules = list(model.policy.mlp_extractor.policy_net) + [model.policy.action_net]
+    else:
+        modules = list(model.q_net.q_net)
+    for module in modules:
+        if isinstance(module, torch.nn.Linear):
+            layers.append((module.weight.detach().cpu().numpy(), module.bias.detach().cpu().numpy()))
+        elif not isinstance(module, (torch.nn.Tanh, torch.nn.ReLU)):
+            raise RuntimeError("cannot export layer %r" % module)
+    activation = "tanh" if any(isinstance(m, torch.nn.Tanh) for m in modules) else "relu"
+    if activation != "tanh":
+        raise RuntimeError("the .npz format runs tanh MLPs; train with activation tanh")
+    n_in = layers[0][0].shape[1]
+    policy = NumpyPolicy(layers, np.full(n_in, OBS_SCALE), actions.discrete_table("gazebo"),
+                         kwargs["observation"], kwargs.get("downsample", 1), dt,
+                         meta={"task": kwargs["task"], "world": str(kwargs["world"]),
+                               "turning": "gazebo"}, source=path)
+    policy.save(path)
+    return policy
+
+
+def read_monitor(paths):
+    """(timestep at episode end, return) of every episode, in order of wall time."""
+    rows = []
+    for path in paths:
+        if not os.path.exists(path):
+            continue
+        with open(path) as f:
+            next(f)                                   # the JSON header line
+            for row in csv.DictReader(f):
+                rows.append((float(row["t"]), int(row["l"]), float(row["r"])))
+    rows.sort()
+    steps = np.cumsum([r[1] for r in rows])
+    return steps, np.array([r[2] for r in rows])
+
+
+def plot_curve(steps, returns, path, title):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 3.5), dpi=100)
+    ax.plot(steps, returns, ".", ms=2, alpha=0.3, color="tab:blue", label="episode return")
+    if len(returns) >= 5:
+        window = max(5, len(returns) // 30)
+        smooth = np.convolve(returns, np.ones(window) / window, mode="valid")
+        ax.plot(steps[window - 1:], smooth, color="tab:blue", lw=2, label="mean of %d" % window)
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("return")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    try:
+        import torch
+        from stable_baselines3 import DQN, PPO
+        from stable_baselines3.common.callbacks import BaseCallback
+        from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+    except ImportError as err:
+        sys.stderr.write("train: %s; run scripts/train.sh, which installs "
+                         "requirements-train.txt first\n" % err)
+        return 2
+    torch.set_num_threads(1)                 # 2 shared cores: the envs need them more
+    os.makedirs(args.out, exist_ok=True)
+    kwargs = env_kwargs(args)
+    from .env import M2wrEnv
+    probe = M2wrEnv(**kwargs)                # checks the options before any process starts
+    dt = probe.dt
+    probe.close()
+    monitors = [os.path.join(args.out, "%d.monitor.csv" % i) for i in range(args.envs)]
+    builders = [make_env(kwargs, monitors[i]) for i in range(args.envs)]
+    venv = SubprocVecEnv(builders) if args.envs > 1 else DummyVecEnv(builders)
+    venv.seed(args.seed)
+    hidden = list(args.hidden)
+    if args.algo == "ppo":
+        n_steps = max(64, min(1024, args.timesteps // args.envs))     # short runs: one rollout
+        model = PPO("MlpPolicy", venv, n_steps=n_steps, batch_size=min(256, n_steps * args.envs),
+                    n_epochs=10,
+                    learning_rate=3e-4, gamma=0.99, gae_lambda=0.95, ent_coef=0.01,
+                    policy_kwargs=dict(net_arch=dict(pi=hidden, vf=hidden),
+                                       activation_fn=torch.nn.Tanh),
+                    seed=args.seed, verbose=0, device="cpu")
+    else:
+        model = DQN("MlpPolicy", venv, learning_rate=5e-4, buffer_size=100000,
+                    learning_starts=5000, exploration_fraction=0.3, target_update_interval=2000,
+                    policy_kwargs=dict(net_arch=hidden, activation_fn=torch.nn.Tanh),
+                    seed=args.seed, verbose=0, device="cpu")
+
+    class Progress(BaseCallback):
+        def __init__(self):
+            super().__init__()
+            self.started = time.monotonic()
+            self.next_report = args.report_every
+
+        def _on_step(self):
+            if self.num_timesteps >= self.next_report or self.num_timesteps >= args.timesteps:
+                self.next_report += args.report_every
+                elapsed = time.monotonic() - self.started
+                rate = self.num_timesteps / max(elapsed, 1e-9)
+                _, returns = read_monitor(monitors)
+                recent = returns[-50:]
+                print("[train] %7d/%d steps  %4d episodes  mean return (last %d) %7.2f  "
+                      "%5.0f steps/s  %5.0f s elapsed, ~%4.0f s left"
+                      % (self.num_timesteps, args.timesteps, len(returns), len(recent),
+                         recent.mean() if len(recent) else math.nan, rate, elapsed,
+                         (args.timesteps - self.num_timesteps) / max(rate, 1e-9)), flush=True)
+            return True
+
+    started = time.monotonic()
+    print("[train] %s on %s in %s, %d environment(s), %d steps of %.2f s sim time; output %s"
+          % (args.algo.upper(), args.task, args.world, args.envs, args.timesteps, dt, args.out),
+          flush=True)
+    try:
+        model.learn(total_timesteps=args.timesteps, callback=Progress())
+    except KeyboardInterrupt:
+        print("[train] interrupted: exporting what was learned so far", flush=True)
+    finally:
+        venv.close()
+    wall = time.monotonic() - started
+    model.save(os.path.join(args.out, "model.zip"))
+    policy_path = os.path.join(args.out, "policy.npz")
+    export(model, kwargs, args, dt, policy_path)
+    steps, returns = read_monitor(monitors)
+    curve = os.path.join(args.out, "learning_curve.png")
+    plot_curve(steps, returns, curve, "%s %s, %s, %d steps in %.0f min wall time"
+               % (args.algo.upper(), args.task, args.world, int(steps[-1]) if len(steps) else 0,
+                  wall / 60.0))
+    print("[train] done in %.0f s: %s, %s" % (wall, policy_path, curve), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main())
+    except KeyboardInterrupt:
+        sys.exit(130)
