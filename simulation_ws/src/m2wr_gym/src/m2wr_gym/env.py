@@ -159,6 +159,8 @@ class M2wrEnv(gymnasium.Env):
             reward, terminated = tasks.goal_reward(pose0, pose1, self._goal,
                                                    self.options.goal_tolerance, nearest,
                                                    after.touched)
+        if terminated and after.touched and not self.options.end_on_contact:
+            terminated = False
         truncated = not terminated and self._steps >= self.max_steps
         return self._observe(), float(reward), terminated, truncated, self._info(command)
 
@@ -193,10 +195,11 @@ class M2wrEnv(gymnasium.Env):
         title = "%s, t = %.1f s" % (self.options.task, s.sim_time if s else 0.0)
         return self._picture.draw(self._path, scan, self._goal, title)
 
-    def clearance(self):
-        """Smallest distance [m] from m2wr's footprint to an obstacle's, now (0 = touching)."""
+    def clearance(self, within=np.inf):
+        """Smallest distance [m] from m2wr's footprint to an obstacle's, now (0 = touching;
+        inf when nothing is within `within` [m])."""
         s = self._snapshot
-        return self.footprints.clearance(s.x, s.y, s.yaw)
+        return self.footprints.clearance(s.x, s.y, s.yaw, within)
 
     def close(self):
         if getattr(self, "sim", None) is not None:

@@ -68,6 +68,10 @@ class Footprints:
                         self.polygon_models.append(model.name)
         self.circles = np.array(circles, dtype=float).reshape(-1, 3)
         self.polygons = polygons
+        # each polygon's bounding circle, to skip the far ones
+        self._centres = np.array([p.mean(axis=0) for p in polygons]).reshape(-1, 2)
+        self._radii = np.array([np.linalg.norm(p - c, axis=1).max()
+                                for p, c in zip(polygons, self._centres)])
         corners = [p for p in polygons] + [np.array([[x - r, y - r], [x + r, y + r]])
                                            for x, y, r in self.circles]
         everything = np.concatenate(corners) if corners else np.zeros((1, 2))
@@ -104,31 +108,35 @@ class Footprints:
         return "polygon", _hull(vertices[:, :2])
 
     # --- distances ----------------------------------------------------------------------
-    def distance(self, points):
-        """(M,) smallest distance [m] from each 2-D point to any footprint (0 inside one),
-        and the index of the nearest model name in `names()`."""
+    def distance(self, points, within=np.inf):
+        """(M,) smallest distance [m] from each 2-D point to any footprint (0 inside one);
+        footprints farther than `within` [m] from all the points may be skipped (inf then)."""
         points = np.asarray(points, dtype=float).reshape(-1, 2)
         best = np.full(len(points), np.inf)
         if len(self.circles):
             d = np.linalg.norm(points[:, None, :] - self.circles[None, :, :2], axis=2) \
                 - self.circles[None, :, 2]
             best = np.minimum(best, np.maximum(d, 0.0).min(axis=1))
-        for polygon in self.polygons:
-            best = np.minimum(best, _polygon_distance(points, polygon))
+        centre = points.mean(axis=0)
+        spread = np.linalg.norm(points - centre, axis=1).max()
+        near = np.linalg.norm(self._centres - centre, axis=1) - self._radii - spread <= within
+        for index in np.flatnonzero(near):
+            best = np.minimum(best, _polygon_distance(points, self.polygons[index]))
         return best
 
-    def clearance(self, x, y, yaw):
+    def clearance(self, x, y, yaw, within=np.inf):
         """Smallest distance [m] between m2wr's footprint at (x, y, yaw) and any obstacle
-        footprint; 0 when they overlap."""
+        footprint; 0 when they overlap; inf when nothing is within `within` [m]."""
         outline = robot_outline(x, y, yaw)
         inside = self._any_inside_robot(x, y, yaw)
-        return 0.0 if inside else float(self.distance(outline).min())
+        return 0.0 if inside else float(self.distance(outline, within).min())
 
     def _any_inside_robot(self, x, y, yaw):
         """An obstacle vertex or circle centre inside the robot's rectangle (an obstacle
         smaller than the robot that the outline's samples would miss)."""
-        pts = [p for p in self.polygons] + [self.circles[:, :2]]
-        pts = np.concatenate(pts) if pts else np.zeros((0, 2))
+        if not hasattr(self, "_vertices"):
+            self._vertices = np.concatenate([p for p in self.polygons] + [self.circles[:, :2]])
+        pts = self._vertices
         c, s = math.cos(yaw), math.sin(yaw)
         local = (pts - [x, y]) @ np.array([[c, -s], [s, c]])
         return bool(np.any((local[:, 0] > FOOTPRINT_X[0]) & (local[:, 0] < FOOTPRINT_X[1]) &

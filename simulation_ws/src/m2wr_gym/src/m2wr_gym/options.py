@@ -20,6 +20,8 @@ unknown option or value is a ValueError naming it and listing what is accepted.
   goal                 goal task: (x, y) [m], or None for a free point drawn each episode
   goal_tolerance       [m] the goal is reached within this distance (0.3, go_to_point's)
   physics_step         [s] Bullet's fixed step (0.005, the simulator's default)
+  end_on_contact       True (default): a contact ends the episode; False: it is only penalised
+                       and reported in info["touched"] (for evaluations that count contacts)
   invalid_action       "raise" (default) | "end": log the error and truncate the episode, so a
                        vectorised run goes on
   backend              "inprocess" (default) | "ros": drive a running simulator in lockstep
@@ -52,6 +54,7 @@ class EnvOptions:
     goal: object = None
     goal_tolerance: float = 0.3
     physics_step: float = 0.005
+    end_on_contact: bool = True
     invalid_action: str = "raise"
     backend: str = "inprocess"
 
@@ -78,6 +81,7 @@ class EnvOptions:
         choice("turning", actions.TURNINGS)
         choice("invalid_action", ("raise", "end"))
         choice("backend", BACKENDS)
+        choice("end_on_contact", (True, False))
         if not isinstance(self.downsample, numbers.Integral) or self.downsample < 1 \
                 or observation.SCAN_BEAMS % self.downsample:
             raise ValueError("option downsample=%r: give a whole number that divides %d beams "
