@@ -174,25 +174,31 @@ def main(argv=None):
         controllers["learned (%s)" % os.path.basename(args.policy)] = PolicyController(args.policy)
     if args.only in (None, "tutorial"):
         controllers["obstacle_avoidance.py"] = TutorialController()
-    results, rows_out = {}, []
+    results = {}
+    writer, out = None, None
+    if args.csv:                       # one row per run as it ends: a stopped run keeps its rows
+        out = open(args.csv, "w", newline="")
     started = time.monotonic()
     for name, controller in controllers.items():
         results[name] = []
         for i, pose in enumerate(poses):
             row = run_one(controller, args.world, pose, args.seconds, seed=i)
             results[name].append(row)
-            rows_out.append(dict(controller=name, world=args.world, run=i, x=pose[0], y=pose[1],
-                                 yaw=pose[2], **row))
+            if out is not None:
+                record = dict(controller=name, world=args.world, run=i, x=pose[0], y=pose[1],
+                              yaw=pose[2], **row)
+                if writer is None:
+                    writer = csv.DictWriter(out, fieldnames=list(record))
+                    writer.writeheader()
+                writer.writerow(record)
+                out.flush()
             print("[evaluate] %s %s run %2d/%d from (%.2f, %.2f, %.2f): %s, %.1f m, clearance "
                   "%.2f m, stuck %.0f s  (%.0f s elapsed)"
                   % (args.world, name, i + 1, len(poses), pose[0], pose[1], pose[2],
                      "CONTACT" if row["collided"] else "no contact", row["distance"],
                      row["min_clearance"], row["stuck"], time.monotonic() - started), flush=True)
-    if args.csv:
-        with open(args.csv, "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=list(rows_out[0]))
-            writer.writeheader()
-            writer.writerows(rows_out)
+    if out is not None:
+        out.close()
     print("\n%s, %d start poses (seed %d), %.0f s each\n" % (args.world, len(poses),
                                                             args.start_seed, args.seconds))
     print(HEADER)

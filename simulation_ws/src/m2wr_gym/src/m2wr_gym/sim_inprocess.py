@@ -70,8 +70,8 @@ class InProcessSim:
         except SpawnError as err:
             raise ValueError("start pose (x=%.3f, y=%.3f, yaw=%.3f): %s" % (x, y, yaw, err)) \
                 from None
-        drives = [c for c in robot.components if hasattr(c, "set_command")]
-        lasers = [c for c in robot.components if hasattr(c, "measure")]
+        drives = [c for c in robot.parts if hasattr(c, "set_command")]
+        lasers = [c for c in robot.parts if getattr(c, "KEY", None) == "ray"]
         if len(drives) != 1 or len(lasers) != 1:
             raise RuntimeError("m2wr should have one drive and one laser; it has %d and %d"
                                % (len(drives), len(lasers)))

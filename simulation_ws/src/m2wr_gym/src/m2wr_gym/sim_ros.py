@@ -14,9 +14,9 @@ the same sim time as in process):
   on after lockstep_timeout).
 Reset: pause, /gazebo/reset_simulation (sim time 0), /gazebo/set_model_state to the start
 pose, unpause, take the first scan (stamped one physics step), pause.
-The pose is /odom's (the drive's odometrySource world: the true pose), published at the
-drive's updates, one physics step (5 ms) before each scan; contacts come from
-/gazebo/contacts. The laser noise follows the simulator's own `seed`, not reset(seed=...).
+The pose is /odom's (the drive's odometrySource world: the true pose) stamped with the scan's
+sim time (after a reset both are first due at the first physics step, then every 0.05 s);
+contacts come from /gazebo/contacts. The laser noise follows the simulator's own `seed`, not reset(seed=...).
 """
 import math
 import queue
@@ -53,11 +53,14 @@ class RosSim:
         if not rospy.core.is_initialized():
             rospy.init_node("m2wr_gym_env", anonymous=True, disable_signals=True)
         try:
-            rospy.wait_for_service("/gazebo/reset_simulation", timeout=timeout)
+            for name in ("reset_simulation", "pause_physics", "unpause_physics",
+                         "set_model_state", "get_physics_properties", "get_world_properties",
+                         "spawn_urdf_model"):
+                rospy.wait_for_service("/gazebo/" + name, timeout=timeout)
         except rospy.ROSException:
-            raise RosSimError("no simulator answers /gazebo/reset_simulation within %g s; start "
+            raise RosSimError("no simulator answers /gazebo/%s within %g s; start "
                               "one: roslaunch my_worlds launch_world.launch gui:=false "
-                              "real_time_factor:=0 lockstep:=true" % timeout) from None
+                              "real_time_factor:=0 lockstep:=true" % (name, timeout)) from None
         if not rospy.get_param("/gazebo/lockstep", False):
             raise RosSimError("the simulator runs without lockstep, so steps would not be exact;"
                               " start it with lockstep:=true")
@@ -70,16 +73,10 @@ class RosSim:
             raise RosSimError("the simulator's physics step is %g s, the environment's "
                               "physics_step %g s; pass physics_step=%g" % (step, physics_step, step))
         models = call("get_world_properties", GetWorldProperties)().model_names
-        if ROBOT not in models:
-            spawn = rospy.ServiceProxy("/gazebo/spawn_urdf_model", SpawnModel)
-            from geometry_msgs.msg import Pose as PoseMsg
-            pose = PoseMsg()
-            pose.position.z = REST_Z
-            pose.orientation.w = 1.0
-            answer = spawn(ROBOT, robot_urdf(laser_noise), "", pose, "world")
-            if not answer.success:
-                raise RosSimError("could not spawn m2wr: %s" % answer.status_message)
-        elif laser_noise is not None:
+        self._spawn = None if ROBOT in models else \
+            rospy.ServiceProxy("/gazebo/spawn_urdf_model", SpawnModel)
+        self._laser_noise = laser_noise
+        if self._spawn is None and laser_noise is not None:
             rospy.logwarn("m2wr_gym: m2wr is already in the simulator; laser_noise=%s is not "
                           "applied (its URDF's noise is)", laser_noise)
         self._scans = queue.Queue()
@@ -92,7 +89,7 @@ class RosSim:
             rospy.Subscriber(ODOM_TOPIC, Odometry, self._on_odom, queue_size=100),
             rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self._on_contacts, queue_size=100),
         ]
-        self._wait_for_connections()
+        self._connected = False                 # once m2wr is there (it may be spawned at reset)
         self._command = (0.0, 0.0)
         self._time = None
 
@@ -136,8 +133,25 @@ class RosSim:
                 self._publish(self._command)     # an intermediate scan of this step
             # else: a scan from before the reset, still in the queue
 
+    def _spawn_at(self, x, y, yaw):
+        """m2wr into the simulator at the first start pose (its reset pose from then on)."""
+        from geometry_msgs.msg import Pose as PoseMsg
+        pose = PoseMsg()
+        pose.position.x, pose.position.y, pose.position.z = x, y, REST_Z
+        pose.orientation.z, pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+        answer = self._spawn(ROBOT, robot_urdf(self._laser_noise), "", pose, "world")
+        if not answer.success:
+            raise ValueError("start pose (x=%.3f, y=%.3f, yaw=%.3f): the simulator could not "
+                             "spawn m2wr: %s" % (x, y, yaw, answer.status_message))
+        self._spawn = None
+
     def reset(self, x, y, yaw, seed=None):
         from gazebo_msgs.msg import ModelState
+        if self._spawn is not None:
+            self._spawn_at(x, y, yaw)
+        if not self._connected:
+            self._wait_for_connections()
+            self._connected = True
         self._pause()
         self._reset_sim()
         state = ModelState()
@@ -197,7 +211,7 @@ class RosSim:
                 with self._lock:
                     odom = self._odom
                 if odom is not None and odom.header.stamp.to_sec() >= \
-                        msg.header.stamp.to_sec() - self.physics_step - _SLACK:
+                        msg.header.stamp.to_sec() - _SLACK:
                     break
                 if time.monotonic() > deadline:
                     raise RosSimError("no /odom for sim time %.3f s" % msg.header.stamp.to_sec())

@@ -1,0 +1,110 @@
+"""Speed figures of the environments (printed, never asserted): `python -m m2wr_gym.bench`.
+
+1. One in-process environment (world02, 10 Hz control, 720-beam scan, random continuous
+   actions, episodes of 120 s from random free starts, resets included) against bare Bullet:
+   the same world and m2wr built by the same World, driven by a constant command, stepped with
+   client.stepSimulation() alone (no laser, no drive updates, no contacts). Both as sim
+   seconds per wall second; the ratio is the environment's share of Bullet's speed.
+2. Two environments in subprocesses (gymnasium's AsyncVectorEnv) against one, in env steps
+   per second of wall time.
+Measurements alternate in rounds (--rounds) and the best round of each is kept, so a busy
+moment of a shared machine hits both sides alike.
+"""
+import argparse
+import time
+
+import gymnasium
+import numpy as np
+from gymnasium.vector import AsyncVectorEnv
+
+from pybullet_gazebo.engine.transforms import Pose
+
+KWARGS = dict(world="world02", start="random", observation="scan", action="continuous",
+              control_rate=10.0, max_episode_seconds=120.0, end_on_contact=False)
+
+
+def make():
+    return gymnasium.make("m2wr_gym:M2wrAvoid-v0", **KWARGS)
+
+
+def bare_bullet(seconds):
+    """Sim seconds per wall second of stepSimulation alone on the env's world and robot."""
+    env = make().unwrapped
+    env.reset(seed=0)
+    sim = env.sim
+    sim._drive.set_command(0.3, 0.2)
+    sim.world.step()                      # the drive applies the command once
+    client, steps = sim.client, int(seconds / sim.physics_step)
+    started = time.perf_counter()
+    for _ in range(steps):
+        client.stepSimulation()
+    wall = time.perf_counter() - started
+    env.close()
+    return steps * sim.physics_step / wall
+
+
+def one_env(steps, seed=0):
+    env = make()
+    env.action_space.seed(seed)
+    env.reset(seed=seed)
+    started = time.perf_counter()
+    for _ in range(steps):
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+    wall = time.perf_counter() - started
+    dt = env.unwrapped.dt
+    env.close()
+    return steps * dt / wall, steps / wall
+
+
+def vector_env(n, steps):
+    vector = AsyncVectorEnv([make] * n)
+    try:
+        vector.action_space.seed(0)
+        vector.reset(seed=list(range(n)))
+        vector.step(vector.action_space.sample())        # workers warm
+        started = time.perf_counter()
+        for _ in range(steps):
+            vector.step(vector.action_space.sample())    # autoreset inside
+        wall = time.perf_counter() - started
+    finally:
+        vector.close()
+    return n * steps / wall
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--rounds", type=int, default=3)
+    p.add_argument("--steps", type=int, default=600, help="env steps per measurement")
+    args = p.parse_args(argv)
+    bare, env_rate, env_steps, one_sub, two_sub = [], [], [], [], []
+    for r in range(args.rounds):
+        bare.append(bare_bullet(args.steps * 0.1))
+        rate, per_s = one_env(args.steps, seed=r)
+        env_rate.append(rate)
+        env_steps.append(per_s)
+        one_sub.append(vector_env(1, args.steps))
+        two_sub.append(vector_env(2, args.steps))
+        print("[bench] round %d/%d: bare Bullet %.0fx real time, env %.0fx (%.0f steps/s), "
+              "1 subprocess %.0f steps/s, 2 subprocesses %.0f steps/s"
+              % (r + 1, args.rounds, bare[-1], env_rate[-1], env_steps[-1], one_sub[-1],
+                 two_sub[-1]), flush=True)
+    print("\nbest of %d rounds, %d env steps each (world02, 10 Hz, 720 beams, random actions):"
+          % (args.rounds, args.steps))
+    print("  bare Bullet stepping (same world + m2wr):  %6.0f sim s / wall s" % max(bare))
+    print("  one environment in process:              %6.0f sim s / wall s  (%.0f env steps/s)"
+          % (max(env_rate), max(env_steps)))
+    print("  environment / bare Bullet:               %6.2f" % (max(env_rate) / max(bare)))
+    print("  one environment in a subprocess:         %6.0f env steps/s" % max(one_sub))
+    print("  two environments in subprocesses:        %6.0f env steps/s  (%.2fx one in a "
+          "subprocess, %.2fx one in process)" % (max(two_sub), max(two_sub) / max(one_sub),
+                                                 max(two_sub) / max(env_steps)))
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        raise SystemExit(main())
+    except KeyboardInterrupt:
+        raise SystemExit(130)
