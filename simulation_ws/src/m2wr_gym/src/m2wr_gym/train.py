@@ -160,7 +160,7 @@ def main(argv=None):
     hidden = list(args.hidden)
     if args.algo == "ppo":
         n_steps = max(64, min(1024, args.timesteps // args.envs))     # short runs: one rollout
-        model = PPO("MlpPolicy", venv, n_steps=n_steps, batch_size=min(256, n_steps * args.envs),
+        model = PPO("MlpPolicy", venv, n_steps=n_steps, batch_size=256 if n_steps == 1024 else n_steps * args.envs,
                     n_epochs=10,
                     learning_rate=3e-4, gamma=0.99, gae_lambda=0.95, ent_coef=0.01,
                     policy_kwargs=dict(net_arch=dict(pi=hidden, vf=hidden),

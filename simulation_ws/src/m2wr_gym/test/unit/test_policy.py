@@ -118,10 +118,19 @@ def test_node_decides_every_control_period_and_answers_every_scan(monkeypatch):
         node_module.check(goal_policy)
 
 
+def wall_ahead(d):
+    """The five regions of a straight wall d [m] ahead, across the robot's path: the
+    front-left/right regions' nearest beams are 18 deg off, the left/right ones 54 deg."""
+    return np.array([d / np.cos(np.radians(54)), d / np.cos(np.radians(18)), d,
+                     d / np.cos(np.radians(18)), d / np.cos(np.radians(54))])
+
+
 def test_shipped_policy_drives_forward_in_the_open_and_turns_at_a_wall():
     policy = load(SHIPPED)
     assert policy.observation == "regions" and policy.input_size == 5
     assert policy.control_period == pytest.approx(0.1)
     forward, left, right = (tuple(r) for r in actions.discrete_table("gazebo"))
     assert policy.command(np.full(5, 10.0)) == forward
-    assert policy.command(np.array([10, 10, 0.4, 10, 10])) != forward
+    assert policy.command(wall_ahead(3.0)) == forward
+    for d in (0.9, 0.6, 0.4):
+        assert policy.command(wall_ahead(d)) in (left, right), d
