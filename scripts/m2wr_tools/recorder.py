@@ -24,9 +24,7 @@ from rosgraph_msgs.msg import Log
 from sensor_msgs.msg import LaserScan
 
 from . import summary
-
-CONTROLLER_NODE = "/reading_laser"
-SCAN_TOPIC = "/m2wr/laser/scan"
+from .names import CONTACTS_TOPIC, CONTROLLER_NODE, ODOM_TOPIC, ROSOUT_AGG_TOPIC, SCAN_TOPIC
 
 
 class Recorder:
@@ -47,9 +45,9 @@ class Recorder:
         self._subscribers = []
         if subscribe:
             sub = self._subscribers.append
-            sub(rospy.Subscriber("/odom", Odometry, self.on_odom, queue_size=1000))
-            sub(rospy.Subscriber("/rosout_agg", Log, self.on_log, queue_size=1000))
-            sub(rospy.Subscriber("/gazebo/contacts", ContactsState, self.on_contacts,
+            sub(rospy.Subscriber(ODOM_TOPIC, Odometry, self.on_odom, queue_size=1000))
+            sub(rospy.Subscriber(ROSOUT_AGG_TOPIC, Log, self.on_log, queue_size=1000))
+            sub(rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self.on_contacts,
                                  queue_size=100))
 
     def unregister(self):
