@@ -12,6 +12,8 @@ SCAN_TOPIC = "/m2wr/laser/scan"            # sensor_msgs/LaserScan, 20 Hz of sim
 COMMAND_TOPIC = "/cmd_vel"                 # geometry_msgs/Twist, the controller's answer
 ODOM_TOPIC = "/odom"                       # nav_msgs/Odometry (true pose of link_chassis)
 CLOCK_TOPIC = "/clock"                     # rosgraph_msgs/Clock
+TF_TOPIC = "/tf"                           # tf2_msgs/TFMessage: odom -> link_chassis
+BASE_FRAME = "link_chassis"                # m2wr's base frame (the diff drive's robotBaseFrame)
 CONTACTS_TOPIC = "/gazebo/contacts"        # gazebo_msgs/ContactsState: what the robot touches
 ROSOUT_AGG_TOPIC = "/rosout_agg"           # rosgraph_msgs/Log, every node's log lines
 

@@ -96,7 +96,8 @@ class Session:
             return None
 
     def launch_world(self, world, gui=False, real_time_factor=0.0, lockstep=True, seed=0,
-                     paused=False, pub_clock_frequency=None, contacts=True, extra=()):
+                     paused=False, pub_clock_frequency=None, contacts=True,
+                     lockstep_timeout=None, extra=()):
         """Starts the world; `contacts` turns on /gazebo/contacts (the demo's summary, the
         bench and the batch runner count touches from it)."""
         args = ["roslaunch", "--sigint-timeout=10", "--sigterm-timeout=3", *WORLD_LAUNCH,
@@ -107,6 +108,8 @@ class Session:
                 "pause:=%s" % str(bool(paused)).lower()]
         if pub_clock_frequency is not None:
             args.append("pub_clock_frequency:=%g" % pub_clock_frequency)
+        if lockstep_timeout is not None:
+            args.append("lockstep_timeout:=%g" % lockstep_timeout)
         args.extend(extra)
         return self._start("world", args)
 
