@@ -93,8 +93,13 @@ class Rig:
             os.environ[BATCH_TAG] = options.batch
         log_dir = os.path.join(options.output, "logs", "worker-%s-%d" % (socket.gethostname(),
                                                                         os.getpid()))
-        self.session = Session(log_dir, name=NODE.lstrip("/"))
-        uri = self.session.start_master()
+        session = Session(log_dir, name=NODE.lstrip("/"))
+        try:
+            uri = session.start_master()
+        except SessionError:
+            session.stop_all()
+            raise
+        self.session = session
         os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
         os.environ.pop("ROS_IP", None)
         import rospy
