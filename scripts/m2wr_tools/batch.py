@@ -60,6 +60,8 @@ def run_batch(scenarios, options: RunOptions, scheduler=None, workers=None, resu
     wanted = {s.run_id: s for s in scenarios}
     records = {k: v for k, v in done.items() if k in wanted}
     todo = [s for s in scenarios if s.run_id not in records]
+    # every worker puts the tag in its children's environment (rig.Rig), not in its own
+    options.batch = options.batch or uuid.uuid4().hex
     batch_info = {"runs": len(scenarios), "options": options_dict(options),
                   "scheduler": scheduler or "LocalCluster(%s workers)" % workers}
     if records:
@@ -68,8 +70,6 @@ def run_batch(scenarios, options: RunOptions, scheduler=None, workers=None, resu
     if not todo:
         results.write(options.output, records.values(), batch_info)
         return sorted(records.values(), key=lambda r: r["run_id"])
-    options.batch = options.batch or uuid.uuid4().hex
-    os.environ[BATCH_TAG] = options.batch            # LocalCluster workers inherit it
 
     def interrupt(signum, _frame):
         raise Interrupted(signal.Signals(signum).name)

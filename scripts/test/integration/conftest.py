@@ -99,8 +99,7 @@ def batch_tag(data):
 def assert_no_process_left(data):
     """No process of the batch (tagged M2WR_BATCH) is alive; kills any found, by PID."""
     tag = batch_tag(data)
-    if not tag:
-        return
+    assert tag, "results.json names no batch tag"
     deadline = time.monotonic() + 10.0
     while processes.tagged("M2WR_BATCH", tag) and time.monotonic() < deadline:
         time.sleep(0.2)
