@@ -172,6 +172,7 @@ class Rig:
             record.update(self._run(scenario, options, log_path, runs_dir))
         except RunFailed as err:
             record.update(success=False, reason=str(err))
+            self.key = None       # the loop may still wait for that controller: relaunch
         except SessionError as err:            # the simulator itself failed: relaunch next time
             record.update(success=False, reason="simulator: %s" % err)
             self.key = None
@@ -266,6 +267,10 @@ class Rig:
         if not controller.running():
             exit_status = "exit %s" % controller.returncode
         else:
+            # Lockstep may be holding the loop for the answer to the last scan: once it comes,
+            # the loop takes its last step and idles. Stopping the controller before that
+            # would leave the loop waiting, and its last step would land in the next run.
+            self._wait_quiet()
             controller.signal_group(signal.SIGINT)     # it ends while the run is measured
         time.sleep(0.2)                       # the last messages arrive (physics is paused)
         if outcome is None and self.commands == 0:
@@ -279,7 +284,19 @@ class Rig:
             result["controller_exit"] = exit_status
         if outcome is not None:
             result.update(success=False, reason=outcome)
+            self.key = None       # the loop may still wait for that controller: relaunch
         return result
+
+    def _wait_quiet(self, quiet=0.25, timeout=5.0):
+        """Until no cmd_vel has come for `quiet` [s] of wall time (at most `timeout`)."""
+        deadline = time.monotonic() + timeout
+        count, since = self.commands, time.monotonic()
+        while time.monotonic() < deadline:
+            time.sleep(0.05)
+            if self.commands != count:
+                count, since = self.commands, time.monotonic()
+            elif time.monotonic() - since >= quiet:
+                return
 
     def _wait(self, condition, timeout, what):
         deadline = time.monotonic() + timeout
