@@ -11,7 +11,7 @@ from . import benchmath, processes
 from .benchmath import fmt
 from .gazebo import call_empty
 from .names import (CLOCK_TOPIC, COMMAND_TOPIC, CONTACTS_TOPIC, CONTROLLER_NODE, DEFAULT_START,
-                    DEFAULT_WORLD, PAUSE_SERVICE, SCAN_TOPIC, SIMULATOR_NODE,
+                    DEFAULT_WORLD, PAUSE_SERVICE, SCAN_TOPIC, SIMULATOR_NODE, TF_TOPIC,
                     UNPAUSE_SERVICE)
 from .session import SessionError
 from .summary import is_case
@@ -129,7 +129,7 @@ def start_loop(session, lockstep, clock_hz):
 WATCHERS = {
     "watch_model_states": ["rostopic", "hz", "/gazebo/model_states"],
     "robot_state_publisher": ["rosrun", "robot_state_publisher", "robot_state_publisher"],
-    "watch_tf": ["rostopic", "hz", "/tf"],
+    "watch_tf": ["rostopic", "hz", TF_TOPIC],
     "watch_joint_states": ["rostopic", "hz", "/joint_states"],
 }
 
