@@ -4,7 +4,8 @@
 #   scripts/setup.sh          install what is missing, then build both catkin workspaces
 #
 # Steps: Debian's ROS 1 packages -> .venv from /usr/bin/python3 (--system-site-packages, so
-# Debian's rospy stays importable) -> pinned PyPI packages -> catkin_make simulation_ws, then
+# Debian's rospy stays importable) -> pinned PyPI packages -> the tools package (scripts/,
+# editable) -> catkin_make simulation_ws, then
 # catkin_ws on top of it. Idempotent: on a ready machine it only re-checks and re-runs the
 # (incremental) catkin builds.
 set -euo pipefail
@@ -78,6 +79,20 @@ else
   "$VENV/bin/python" -c "import rospy, pybullet, numpy, numba, xacro" \
     || fail "the venv cannot import rospy, pybullet, numpy, numba and xacro together"
   echo "$want" > "$stamp"
+fi
+
+STEP="tools package"
+# m2wr_tools (scripts/m2wr_tools) installed editable, so every venv python imports it; checked
+# from / so that the current folder cannot stand in for the installed package
+tools_at="$(cd / && "$VENV/bin/python" -c \
+  "import os, m2wr_tools; print(os.path.dirname(os.path.abspath(m2wr_tools.__file__)))" 2>/dev/null || true)"
+if [ "$tools_at" = "$ROOT/scripts/m2wr_tools" ]; then
+  say "3/4 tools package: m2wr_tools installed (editable)"
+else
+  say "3/4 tools package: installing scripts/ (m2wr_tools) editable into the venv"
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps \
+    --no-build-isolation -e "$ROOT/scripts" \
+    || fail "pip could not install scripts/ (m2wr_tools) into the venv"
 fi
 
 STEP="catkin build"

@@ -4,7 +4,7 @@
 # Exits non-zero when any test fails or a rostest crashed without writing its results, and
 # ends with one line `N passed, N failed, N skipped`.
 #
-#   scripts/test.sh            everything
+#   scripts/test.sh            everything (unit, rostest, the batch runner's cluster tests)
 #   scripts/test.sh --unit     only the pytest unit tests
 set -uo pipefail
 
@@ -22,8 +22,8 @@ unit_dirs=()
 for d in "$ROOT"/simulation_ws/src/*/test/unit "$ROOT"/catkin_ws/src/*/test/unit "$ROOT/scripts/test"; do
   [ -d "$d" ] && unit_dirs+=("$d")
 done
-python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib --junitxml="$RESULTS/pytest-unit.xml" "${unit_dirs[@]}" \
-  || status=1
+python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib --junitxml="$RESULTS/pytest-unit.xml" \
+  --ignore="$ROOT/scripts/test/integration" "${unit_dirs[@]}" || status=1
 
 if [ "$mode" != "--unit" ]; then
   for ws in simulation_ws catkin_ws; do
@@ -38,6 +38,10 @@ if [ "$mode" != "--unit" ]; then
     cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
   done
   set +u; source "$ROOT/scripts/env.sh"; set -u
+  echo "[test] batch runner (pytest: scripts/evaluate.sh on a real Dask scheduler and workers)"
+  python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib \
+    --basetemp="$RESULTS/batch-tmp" --junitxml="$RESULTS/pytest-batch.xml" \
+    "$ROOT/scripts/test/integration" || status=1
 fi
 
 python "$ROOT/scripts/summarize_test_results.py" "$RESULTS" || status=1

@@ -1,9 +1,9 @@
-"""demo_lib.benchmath: the benchmark's arithmetic and table."""
+"""m2wr_tools.benchmath: the benchmark's arithmetic and table."""
 import math
 
 import pytest
 
-from demo_lib import benchmath
+from m2wr_tools import benchmath
 
 
 def test_rate_and_growth():

@@ -1,11 +1,11 @@
-"""The command lines of scripts/demo.py and scripts/bench.py, and the session's error text."""
+"""The command lines of demo.sh and bench.sh (m2wr_tools.demo, m2wr_tools.bench), and the
+session's error text."""
 import os
 
 import pytest
 
-import bench
-import demo
-from demo_lib.session import _problem_lines
+from m2wr_tools import bench, bench_loop, demo
+from m2wr_tools.session import _problem_lines
 
 
 def test_demo_defaults_are_the_tutorials_episode_5():
@@ -68,7 +68,7 @@ def test_bench_finds_error_lines(tmp_path):
     (tmp_path / "world.log").write_text("[INFO] ok\n[ERROR] [1.0]: bad thing\n")
     (tmp_path / "ros" / "node.log").write_text("Traceback (most recent call last):\n")
     (tmp_path / "notes.txt").write_text("ERROR but not a log\n")
-    found = sorted(bench.error_lines(str(tmp_path)))
+    found = sorted(bench_loop.error_lines(str(tmp_path)))
     assert found == ["ros/node.log: Traceback (most recent call last):",
                      "world.log: [ERROR] [1.0]: bad thing"]
 
@@ -81,5 +81,5 @@ def test_bench_error_lines_skip_logs_of_earlier_runs(tmp_path):
     new = tmp_path / "ros" / "run2" / "master.log"
     new.parent.mkdir(parents=True)
     new.write_text("[ERROR] from this run\n")
-    assert bench.error_lines(str(tmp_path), since=2000.0) == [
+    assert bench_loop.error_lines(str(tmp_path), since=2000.0) == [
         "ros/run2/master.log: [ERROR] from this run"]

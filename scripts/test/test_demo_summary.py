@@ -1,10 +1,10 @@
-"""demo_lib.summary: the run summary's maths and text."""
+"""m2wr_tools.summary: the run summary's maths and text."""
 import math
 
 import pytest
 
-from demo_lib import summary
-from demo_lib.summary import Collision, RunSummary
+from m2wr_tools import summary
+from m2wr_tools.summary import Collision, RunSummary
 
 
 def test_case_lines_are_recognised():

@@ -20,7 +20,8 @@ from std_srvs.srv import Empty
 from gazebo_msgs.srv import GetModelState
 from tf2_msgs.msg import TFMessage
 
-from pybullet_gazebo.ros.testing import service, unwrap_angle, wait_for_message, wait_until_sim_time
+from pybullet_gazebo.ros.testing import (service, unwrap_angle, wait_for_message,
+                                         wait_until_sim_time, yaw_of)
 
 WHEEL_RADIUS = 0.1          # [m]
 FORMULA_SEPARATION = 0.4    # [m] wheelSeparation in the plugin block
@@ -50,8 +51,7 @@ class DriveTest(unittest.TestCase):
     def state(self):
         answer = self.get_state("m2wr", "world")
         self.assertTrue(answer.success, answer.status_message)
-        q = answer.pose.orientation
-        yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+        yaw = yaw_of(answer.pose.orientation)
         return answer.header.stamp.to_sec(), answer.pose.position.x, answer.pose.position.y, yaw
 
     def drive(self, linear, angular, duration):
@@ -102,8 +102,7 @@ class DriveTest(unittest.TestCase):
         self.assertEqual(odom.child_frame_id, "link_chassis")
         self.assertAlmostEqual(odom.pose.pose.position.x, x, delta=0.01)
         self.assertAlmostEqual(odom.pose.pose.position.y, y, delta=0.01)
-        q = odom.pose.pose.orientation
-        odom_yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+        odom_yaw = yaw_of(odom.pose.pose.orientation)
         self.assertAlmostEqual(unwrap_angle(odom_yaw - yaw), 0.0, delta=0.01)
 
     def test_4_odometry_twist_is_in_the_robot_frame(self):

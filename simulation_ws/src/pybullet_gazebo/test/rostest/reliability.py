@@ -10,7 +10,7 @@ from gazebo_msgs.srv import GetModelState
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 
-from pybullet_gazebo.ros.testing import service
+from pybullet_gazebo.ros.testing import service, yaw_of
 
 
 class ClockWatch:
@@ -67,9 +67,8 @@ def state(name="m2wr"):
     """(sim time [s], x, y, z, yaw [rad]) of a model from /gazebo/get_model_state."""
     answer = service("/gazebo/get_model_state", GetModelState)(name, "world")
     assert answer.success, answer.status_message
-    p, q = answer.pose.position, answer.pose.orientation
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-    return answer.header.stamp.to_sec(), p.x, p.y, p.z, yaw
+    p = answer.pose.position
+    return answer.header.stamp.to_sec(), p.x, p.y, p.z, yaw_of(answer.pose.orientation)
 
 
 def node_pid(node="/gazebo", master_uri=None):

@@ -10,11 +10,10 @@ on roughly half the rays that hit a curved shape. The tests therefore check:
 - Bullet agreement: every Bullet hit lies within BULLET_TOLERANCE of that surface, and the
   two report hits on the same rays except rays that pass within that tolerance of it.
 
-Run as a script (`python test_raycast.py`) to print the cost of a 720-beam scan in a world
-like the tutorial's world02, for this caster and for rayTestBatch.
+The cost of a 720-beam scan, this caster against rayTestBatch over the same beams in world02,
+is a figure of scripts/bench.sh (m2wr_tools.bench_engine), not a test.
 """
 import math
-import time
 
 import numpy as np
 import pybullet
@@ -533,36 +532,6 @@ def laser_directions(yaw=0.0, samples=720):
     return np.stack([np.cos(angles), np.sin(angles), np.zeros(samples)], axis=1)
 
 
-def benchmark(casts=300, bullet_casts=50):
-    """Print the cost [ms] of a 720-beam scan from the episode's start pose (0.15, 8, 0.15)
-    in world02: this caster against rayTestBatch. Returns (ours, bullet) [ms]."""
-    client = BulletClient(connection_mode=pybullet.DIRECT)
-    try:
-        static, dynamic = build_world02(client)
-        caster = RayCaster(client)
-        for body in static:
-            caster.add_body(body, static=True)
-        for body in dynamic:
-            caster.add_body(body, static=False)
-        origin = np.array([0.15, 8.0, 0.15])
-        yaws = np.linspace(0, 2 * math.pi, casts, endpoint=False)
-        directions = [laser_directions(yaw) for yaw in yaws]
-        caster.cast(origin, directions[0], 0.1, 10.0)
-        start = time.perf_counter()
-        for d in directions:
-            caster.cast(origin, d, 0.1, 10.0)
-        ours = (time.perf_counter() - start) / casts * 1e3
-        start = time.perf_counter()
-        for d in directions[:bullet_casts]:
-            client.rayTestBatch((origin + 0.1 * d).tolist(), (origin + 10.0 * d).tolist())
-        bullet = (time.perf_counter() - start) / bullet_casts * 1e3
-    finally:
-        client.disconnect()
-    print("720-beam scan in world02 (22 barriers x 6 boxes, 9 dynamic cylinders, ground): "
-          "RayCaster %.3f ms, rayTestBatch %.3f ms" % (ours, bullet))
-    return ours, bullet
-
-
 def test_world02_scan_agrees_with_geometry_and_bullet(client):
     scene = Scene(client)
     static, dynamic = build_world02(client, scene)
@@ -579,12 +548,3 @@ def test_world02_scan_agrees_with_geometry_and_bullet(client):
     # the corner barrel at (9.07, 7.91), r 0.3
     ahead = caster.cast((0.15, 8.0, 0.15), [(1.0, 0.0, 0.0)], 0.1, 10.0)[0]
     assert ahead == pytest.approx(9.07 - math.sqrt(0.3 ** 2 - 0.09 ** 2) - 0.15, abs=EXACT)
-
-
-def test_benchmark_prints_costs():
-    ours, bullet = benchmark(casts=20, bullet_casts=5)
-    assert ours > 0 and bullet > 0
-
-
-if __name__ == "__main__":
-    benchmark()

@@ -4,7 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from pybullet_gazebo.engine.transforms import Pose, cross, rotate, rotation_matrix
+from pybullet_gazebo.engine.transforms import (Pose, cross, quaternion_from_rpy, rotate,
+                                               rotation_matrix, wrap_angle, yaw_from_quaternion)
 
 
 def homogeneous(pose):
@@ -36,3 +37,16 @@ def test_compose_and_inverse_are_matrix_products(a, b):
     assert homogeneous(a.compose(b)) == pytest.approx(homogeneous(a) @ homogeneous(b), abs=1e-12)
     assert homogeneous(a.inverse()) == pytest.approx(np.linalg.inv(homogeneous(a)), abs=1e-12)
     assert all(type(v) is float for v in a.compose(b).position + a.inverse().position)
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.5, -2.0, math.pi - 1e-6, -math.pi + 1e-6])
+def test_yaw_from_quaternion_reads_back_the_heading(yaw):
+    assert yaw_from_quaternion(quaternion_from_rpy(0.0, 0.0, yaw)) == pytest.approx(yaw, abs=1e-9)
+    # a tilted robot still heads the same way
+    assert yaw_from_quaternion(quaternion_from_rpy(0.1, -0.05, yaw)) == pytest.approx(yaw, abs=1e-9)
+
+
+@pytest.mark.parametrize("angle, wrapped", [(0.0, 0.0), (3 * math.pi / 2, -math.pi / 2),
+                                            (-3 * math.pi / 2, math.pi / 2), (7.0, 7.0 - 2 * math.pi)])
+def test_wrap_angle(angle, wrapped):
+    assert wrap_angle(angle) == pytest.approx(wrapped, abs=1e-12)

@@ -11,7 +11,7 @@ from pybullet_utils.bullet_client import BulletClient
 from pybullet_gazebo.engine.diff_drive import DiffDrive
 from pybullet_gazebo.engine.ray_sensor import RaySensor
 from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
-from pybullet_gazebo.engine.transforms import Pose
+from pybullet_gazebo.engine.transforms import Pose, wrap_angle
 from pybullet_gazebo.engine.world import ModelNotFound, SpawnError, World
 
 SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
@@ -101,8 +101,7 @@ def test_turn_on_the_spot_uses_the_real_track_width(make_world, m2wr_urdf):
     for _ in range(4):
         start = world.model_pose("m2wr").rpy[2]
         run(world, 1.0)
-        turned = math.atan2(math.sin(world.model_pose("m2wr").rpy[2] - start),
-                            math.cos(world.model_pose("m2wr").rpy[2] - start))
+        turned = wrap_angle(world.model_pose("m2wr").rpy[2] - start)
         assert turned == pytest.approx(-0.4, abs=0.01)
 
 

@@ -34,6 +34,11 @@ def yaw_from_quaternion(q):
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
+def wrap_angle(angle):
+    """`angle` [rad] wrapped into (-pi, pi]."""
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
 def rotation_matrix(q):
     """3x3 rotation matrix of a unit quaternion (x, y, z, w)."""
     x, y, z, w = q

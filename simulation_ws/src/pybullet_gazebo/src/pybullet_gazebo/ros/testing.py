@@ -1,14 +1,13 @@
 """Helpers for the rostest suites: waiting for messages and services with explicit time-outs,
 reading sim time and model poses, collecting a node's /rosout lines (NodeLog) and the
 simulator's touches from /gazebo/contacts (ContactLog). Used by test nodes only."""
-import math
 import threading
 import time
 
 import rospy
 from gazebo_msgs.srv import GetModelState
 
-from pybullet_gazebo.engine.transforms import yaw_from_quaternion
+from pybullet_gazebo.engine.transforms import wrap_angle, yaw_from_quaternion
 
 
 def wait_for_message(topic, msg_type, timeout=10.0):
@@ -51,7 +50,8 @@ def wait_until_sim_time(target, timeout=60.0):
 
 
 def unwrap_angle(angle):
-    return math.atan2(math.sin(angle), math.cos(angle))
+    """`angle` [rad] wrapped into (-pi, pi]."""
+    return wrap_angle(angle)
 
 
 def yaw_of(orientation):

@@ -3,6 +3,9 @@
 Topics in:
   /odom (nav_msgs/Odometry)                  the robot's true pose: trajectory (t, x, y, z, q);
                                              its stamps are also the demo's sim clock [s]
+  /tf (tf2_msgs/TFMessage)                   instead of /odom with poses_from_tf=BASE_FRAME:
+                                             the odom -> BASE_FRAME transform (the batch runner:
+                                             /tf's publisher drops nothing under load)
   /m2wr/laser/scan (sensor_msgs/LaserScan)   only over the run's last `scan_window` seconds
                                              of sim time: the last scan, and a count
   /rosout_agg (rosgraph_msgs/Log)            obstacle_avoidance.py's case lines (node
@@ -22,17 +25,17 @@ from gazebo_msgs.msg import ContactsState
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 from sensor_msgs.msg import LaserScan
+from tf2_msgs.msg import TFMessage
 
 from . import summary
-
-CONTROLLER_NODE = "/reading_laser"
-SCAN_TOPIC = "/m2wr/laser/scan"
+from .names import (CONTACTS_TOPIC, CONTROLLER_NODE, ODOM_TOPIC, ROSOUT_AGG_TOPIC, SCAN_TOPIC,
+                    TF_TOPIC)
 
 
 class Recorder:
     """Collects a run's data. Construct with subscribe=False to feed callbacks by hand."""
 
-    def __init__(self, subscribe=True, scan_window=3.0):
+    def __init__(self, subscribe=True, scan_window=3.0, poses_from_tf=None):
         self.sim_time = None               # [s] latest odometry stamp
         self.poses = []                    # (t, x, y, z, qx, qy, qz, qw)
         self.last_scan = None              # sensor_msgs/LaserScan
@@ -45,11 +48,15 @@ class Recorder:
         self._scan_sub = None
         self.reached = threading.Event()
         self._subscribers = []
+        self._base_frame = poses_from_tf
         if subscribe:
             sub = self._subscribers.append
-            sub(rospy.Subscriber("/odom", Odometry, self.on_odom, queue_size=1000))
-            sub(rospy.Subscriber("/rosout_agg", Log, self.on_log, queue_size=1000))
-            sub(rospy.Subscriber("/gazebo/contacts", ContactsState, self.on_contacts,
+            if poses_from_tf:
+                sub(rospy.Subscriber(TF_TOPIC, TFMessage, self.on_tf, queue_size=1000))
+            else:
+                sub(rospy.Subscriber(ODOM_TOPIC, Odometry, self.on_odom, queue_size=1000))
+            sub(rospy.Subscriber(ROSOUT_AGG_TOPIC, Log, self.on_log, queue_size=1000))
+            sub(rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self.on_contacts,
                                  queue_size=100))
 
     def unregister(self):
@@ -80,6 +87,18 @@ class Recorder:
         self.poses.append((t, p.x, p.y, p.z, q.x, q.y, q.z, q.w))
         self.sim_time = t if self.sim_time is None else max(self.sim_time, t)
         self._tick()
+
+    def on_tf(self, msg):
+        """The odom -> base transform the simulator sends with each odometry message (the
+        same pose; /tf's publisher queues 100 where /odom's keeps only the latest)."""
+        for transform in msg.transforms:
+            if transform.child_frame_id != self._base_frame:
+                continue
+            p, q = transform.transform.translation, transform.transform.rotation
+            t = transform.header.stamp.to_sec()
+            self.poses.append((t, p.x, p.y, p.z, q.x, q.y, q.z, q.w))
+            self.sim_time = t if self.sim_time is None else max(self.sim_time, t)
+            self._tick()
 
     def on_scan(self, msg):
         self.last_scan = msg

@@ -16,11 +16,8 @@ import time
 import xmlrpc.client
 
 from . import processes
-
-NODE_SIMULATOR = "/gazebo"
-NODE_CONTROLLER = "/reading_laser"      # obstacle_avoidance.py's node name (the tutorial's)
-SCAN_TOPIC = "/m2wr/laser/scan"
-COMMAND_TOPIC = "/cmd_vel"
+from .names import (COMMAND_TOPIC, CONTROLLER_NODE, SCAN_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH,
+                    SPAWN_SERVICE, TUTORIAL_CONTROLLER, WORLD_LAUNCH)
 
 
 class SessionError(RuntimeError):
@@ -99,17 +96,20 @@ class Session:
             return None
 
     def launch_world(self, world, gui=False, real_time_factor=0.0, lockstep=True, seed=0,
-                     paused=False, pub_clock_frequency=None, contacts=True, extra=()):
-        """Starts the world; `contacts` turns on /gazebo/contacts (the demo's summary and the
-        bench count touches from it)."""
-        args = ["roslaunch", "--sigint-timeout=10", "--sigterm-timeout=3", "my_worlds",
-                "launch_world.launch", "world:=%s" % world, "gui:=%s" % str(bool(gui)).lower(),
+                     paused=False, pub_clock_frequency=None, contacts=True,
+                     lockstep_timeout=None, extra=()):
+        """Starts the world; `contacts` turns on /gazebo/contacts (the demo's summary, the
+        bench and the batch runner count touches from it)."""
+        args = ["roslaunch", "--sigint-timeout=10", "--sigterm-timeout=3", *WORLD_LAUNCH,
+                "world:=%s" % world, "gui:=%s" % str(bool(gui)).lower(),
                 "contacts:=%s" % str(bool(contacts)).lower(),
                 "real_time_factor:=%g" % real_time_factor,
                 "lockstep:=%s" % str(bool(lockstep)).lower(), "seed:=%d" % seed,
                 "pause:=%s" % str(bool(paused)).lower()]
         if pub_clock_frequency is not None:
             args.append("pub_clock_frequency:=%g" % pub_clock_frequency)
+        if lockstep_timeout is not None:
+            args.append("lockstep_timeout:=%g" % lockstep_timeout)
         args.extend(extra)
         return self._start("world", args)
 
@@ -122,11 +122,11 @@ class Session:
             if not world.running():
                 raise SessionError("the simulator stopped while starting (roslaunch exit %s):\n%s"
                                    % (world.returncode, _problem_lines(world.log_tail(40))))
-            if self.service_offered("/gazebo/spawn_urdf_model"):
+            if self.service_offered(SPAWN_SERVICE):
                 return
             time.sleep(0.1)
-        raise SessionError("the simulator offered no /gazebo/spawn_urdf_model within %.0f s; "
-                           "see %s" % (timeout, world.log_path))
+        raise SessionError("the simulator offered no %s within %.0f s; see %s"
+                           % (SPAWN_SERVICE, timeout, world.log_path))
 
     def service_offered(self, service):
         try:
@@ -143,7 +143,7 @@ class Session:
 
     def start_spawn(self, x, y, yaw):
         self._spawn_pose = (float(x), float(y), float(yaw))
-        return self._start("spawn", ["roslaunch", "m2wr_description", "spawn.launch",
+        return self._start("spawn", ["roslaunch", *SPAWN_LAUNCH,
                                      "x:=%r" % float(x), "y:=%r" % float(y),
                                      "yaw:=%r" % float(yaw)])
 
@@ -162,8 +162,30 @@ class Session:
             raise SessionError("spawning m2wr at (%g, %g, yaw %g) failed (roslaunch exit %d):\n%s"
                                % (x, y, yaw, code, _problem_lines(log)))
 
-    def start_controller(self):
-        return self._start("controller", ["rosrun", "motion_plan", "obstacle_avoidance.py"])
+    def start_controller(self, argv=TUTORIAL_CONTROLLER, log_name="controller"):
+        """The controller (default: the tutorial's obstacle_avoidance.py) as child
+        "controller"; its output goes to <log_dir>/<log_name>.log."""
+        child = processes.Child("controller", argv, self.env,
+                                os.path.join(self.log_dir, log_name + ".log"))
+        self.children["controller"] = child
+        return child
+
+    def start_episode(self, world, start, lockstep=True, real_time_factor=0.0, seed=0,
+                      pub_clock_frequency=None, gui=False, controller=TUTORIAL_CONTROLLER,
+                      say=lambda _text: None):
+        """The simulator paused on `world`, m2wr spawned at `start` (x [m], y [m], yaw [rad])
+        and `controller` connected to its scan and cmd_vel: ready to unpause. The spawn
+        starts at once (it waits for the simulator's service), the controller once the
+        simulator is up, so that /use_sim_time is set when it starts."""
+        self.launch_world(world, gui=gui, real_time_factor=real_time_factor, lockstep=lockstep,
+                          seed=seed, paused=True, pub_clock_frequency=pub_clock_frequency)
+        say("spawning m2wr at x %g y %g yaw %g" % tuple(start))
+        self.start_spawn(*start)
+        self.wait_for_simulator()
+        say("starting %s" % os.path.basename(controller[-1]))
+        self.start_controller(controller)
+        self.finish_spawn()
+        self.wait_for_controller(label=os.path.basename(controller[-1]))
 
     def start_bag(self, path, topics):
         return self._start("rosbag", ["rosbag", "record", "--quiet", "-O", path] + list(topics))
@@ -188,20 +210,21 @@ class Session:
                 return True
         return False
 
-    def wait_for_controller(self, timeout=30.0):
-        """Until the simulator sends scans to the controller and hears its cmd_vel."""
+    def wait_for_controller(self, timeout=30.0, node=CONTROLLER_NODE,
+                            label="obstacle_avoidance.py"):
+        """Until the simulator sends scans to the controller's `node` and hears its cmd_vel."""
         controller = self.children["controller"]
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if not controller.running():
-                raise SessionError("obstacle_avoidance.py stopped while starting (exit %s):\n%s"
-                                   % (controller.returncode, controller.log_tail()))
-            if self.connected(NODE_SIMULATOR, SCAN_TOPIC, NODE_CONTROLLER) \
-                    and self.connected(NODE_SIMULATOR, COMMAND_TOPIC, NODE_CONTROLLER):
+                raise SessionError("%s stopped while starting (exit %s):\n%s"
+                                   % (label, controller.returncode, controller.log_tail()))
+            if self.connected(SIMULATOR_NODE, SCAN_TOPIC, node) \
+                    and self.connected(SIMULATOR_NODE, COMMAND_TOPIC, node):
                 return
             time.sleep(0.05)
-        raise SessionError("obstacle_avoidance.py did not connect to the simulator within %.0f s"
-                           "; see %s" % (timeout, controller.log_path))
+        raise SessionError("%s did not connect to the simulator within %.0f s; see %s"
+                           % (label, timeout, controller.log_path))
 
     def check_running(self, names):
         """SessionError naming the first of `names` that is no longer running."""

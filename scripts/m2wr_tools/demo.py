@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """The tutorial's episode 5, end to end: m2wr in world02 driven by obstacle_avoidance.py.
 
   scripts/demo.sh [--world world02] [--x 0 --y 8 --yaw 0] [--duration 120] [--seed 0]
@@ -25,15 +24,14 @@ import signal
 import sys
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
+from . import processes, summary
+from .names import (COMMAND_TOPIC, CONTROLLER_NODE, DEFAULT_START, DEFAULT_WORLD, ODOM_TOPIC,
+                    PAUSE_SERVICE, SCAN_TOPIC, SIMULATOR_NODE, UNPAUSE_SERVICE)
+from .paths import ROOT
+from .scene import SCAN_HEIGHT
+from .session import Session, SessionError
 
-from demo_lib import processes, summary                 # noqa: E402
-from demo_lib.session import Session, SessionError      # noqa: E402
-
-BAG_TOPICS = ("/m2wr/laser/scan", "/odom", "/cmd_vel")
-SCAN_HEIGHT = 0.15          # [m] the laser's plane above the ground, where obstacles are cut
+BAG_TOPICS = (SCAN_TOPIC, ODOM_TOPIC, COMMAND_TOPIC)
 PROGRESS_PERIOD = 2.0       # [s] wall
 CLEARANCE_RANGE = 50.0      # [m] obstacles farther than this count as none
 DEFAULT_CLOCK_HZ = 20.0     # [Hz] sim; the simulator also publishes /clock with every scan
@@ -48,12 +46,12 @@ def parse_args(argv):
         prog="demo.sh", description="Episode 5 of 'Exploring ROS with a 2 Wheeled Robot': "
         "obstacle_avoidance.py drives m2wr in the pybullet stand-in; writes a picture and a "
         "summary.")
-    parser.add_argument("--world", default="world02",
+    parser.add_argument("--world", default=DEFAULT_WORLD,
                         help="world01, world02 or a path to a .world file (default world02)")
-    parser.add_argument("--x", type=float, default=0.0, help="start x [m] (default 0)")
-    parser.add_argument("--y", type=float, default=8.0, help="start y [m] (default 8, the "
+    parser.add_argument("--x", type=float, default=DEFAULT_START[0], help="start x [m] (default 0)")
+    parser.add_argument("--y", type=float, default=DEFAULT_START[1], help="start y [m] (default 8, the "
                         "tutorial's `spawn.launch y:=8`)")
-    parser.add_argument("--yaw", type=float, default=0.0, help="start heading [rad] (default 0)")
+    parser.add_argument("--yaw", type=float, default=DEFAULT_START[2], help="start heading [rad] (default 0)")
     parser.add_argument("--duration", type=float, default=120.0,
                         help="sim time to run the controller [s] (default 120)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the laser noise (default 0)")
@@ -93,33 +91,11 @@ def say(text):
     print("[demo %5.1fs] %s" % (time.monotonic() - _T0, text), flush=True)
 
 
-def call_empty(name, timeout=10.0):
-    import rospy
-    from std_srvs.srv import Empty
-    rospy.wait_for_service(name, timeout=timeout)
-    rospy.ServiceProxy(name, Empty)()
-
-
-def model_poses():
-    """{name: Pose} of every model, from /gazebo/get_world_properties and get_model_state."""
-    import rospy
-    from gazebo_msgs.srv import GetModelState, GetWorldProperties
-    from pybullet_gazebo.engine.transforms import Pose
-    names = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)().model_names
-    get = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
-    poses = {}
-    for name in names:
-        state = get(name, "")
-        if state.success:
-            p, q = state.pose.position, state.pose.orientation
-            poses[name] = Pose((p.x, p.y, p.z), (q.x, q.y, q.z, q.w))
-    return poses
-
-
 def run(args, session, paths):
     """The ROS part; returns what the offline part needs."""
     import rospy
-    from demo_lib.recorder import Recorder
+    from .gazebo import call_empty, model_poses
+    from .recorder import Recorder
 
     realtime = args.realtime or args.gui
     say("starting a ROS master on a free port")
@@ -132,29 +108,18 @@ def run(args, session, paths):
 
     say("simulator: %s, %s" % (args.world, "real time" if realtime
                                 else "as fast as possible, lockstep"))
-    session.launch_world(args.world, gui=args.gui, real_time_factor=1.0 if realtime else 0.0,
-                         lockstep=not realtime, seed=args.seed, paused=True,
-                         pub_clock_frequency=args.clock_hz)
-    # spawn_model starts at once (it waits for the simulator's service); the controller
-    # once the simulator is up, so that /use_sim_time is set when it starts, while the
-    # robot is being spawned (physics is paused until everything is connected)
-    say("spawning m2wr at x %g y %g yaw %g" % (args.x, args.y, args.yaw))
-    session.start_spawn(args.x, args.y, args.yaw)
-    session.wait_for_simulator()
-    say("starting obstacle_avoidance.py")
-    session.start_controller()
-    session.finish_spawn()
+    session.start_episode(args.world, (args.x, args.y, args.yaw), lockstep=not realtime,
+                          real_time_factor=1.0 if realtime else 0.0, seed=args.seed,
+                          pub_clock_frequency=args.clock_hz, gui=args.gui, say=say)
     urdf = rospy.get_param("/robot_description")
     if args.bag:
         session.start_bag(paths["bag"], BAG_TOPICS)
-    session.wait_for_controller()
-    if args.bag:
         _wait_for_bag(session)
     say("m2wr spawned, obstacle_avoidance.py connected; running")
 
     start = recorder.sim_time or 0.0
     recorder.fire_at(start + args.duration)
-    call_empty("/gazebo/unpause_physics")
+    call_empty(UNPAUSE_SERVICE)
     wall_start = time.monotonic()
     last_wall, last_sim = wall_start, start
     watch = ["world", "controller"] + (["rosbag"] if args.bag else [])
@@ -165,7 +130,7 @@ def run(args, session, paths):
                                   summary.real_time_factor(now_sim - last_sim, now_wall - last_wall),
                                   recorder.current_case()))
         last_wall, last_sim = now_wall, now_sim
-    call_empty("/gazebo/pause_physics")
+    call_empty(PAUSE_SERVICE)
     wall = time.monotonic() - wall_start
     poses = model_poses()
     time.sleep(0.3)          # the last queued messages arrive (physics is paused)
@@ -181,8 +146,8 @@ def _wait_for_bag(session, timeout=15.0):
     simulator's scan and odometry, the controller's cmd_vel), so the bag starts at 0 s."""
     import rosgraph
     master = rosgraph.Master("/m2wr_demo")
-    publishers = {"/m2wr/laser/scan": "/gazebo", "/odom": "/gazebo",
-                  "/cmd_vel": "/reading_laser"}
+    publishers = {SCAN_TOPIC: SIMULATOR_NODE, ODOM_TOPIC: SIMULATOR_NODE,
+                  COMMAND_TOPIC: CONTROLLER_NODE}
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         session.check_running(["rosbag"])
@@ -198,17 +163,12 @@ def _wait_for_bag(session, timeout=15.0):
 def analyse(args, data, paths):
     """The offline part: clearance, picture, summary."""
     import numpy as np
-    from demo_lib import picture
-    from demo_lib.scene import Scene
-    from pybullet_gazebo.engine.sdf_world import find_world, model_path_from_env
+    from . import picture
+    from .scene import Scene
     from pybullet_gazebo.engine.transforms import Pose
-    import rospkg
 
     recorder, start, end = data["recorder"], data["start"], data["end"]
-    rospack = rospkg.RosPack()
-    world_path = find_world(args.world, os.path.join(rospack.get_path("my_worlds"), "worlds"))
-    model_path = model_path_from_env(os.path.join(rospack.get_path("pybullet_gazebo"), "models"))
-    scene = Scene(world_path, model_path, data["urdf"])
+    scene = Scene.of_world(args.world, data["urdf"])
     try:
         scene.set_model_poses({n: p for n, p in data["poses"].items() if n != scene.robot_name})
         track = np.array([p for p in recorder.poses if start - 1e-9 <= p[0] <= end + 1e-9]) \

@@ -125,13 +125,19 @@ def environment_of(pid):
 def leftovers(master_uri, exclude=()):
     """PIDs of live processes (zombies excluded) started with ROS_MASTER_URI == master_uri,
     other than this process and `exclude`."""
+    return tagged("ROS_MASTER_URI", master_uri, exclude)
+
+
+def tagged(name, value, exclude=()):
+    """PIDs of live processes (zombies excluded) whose start-up environment has name=value,
+    other than this process and `exclude`."""
     skip = {os.getpid(), *exclude}
     found = []
     for entry in os.listdir("/proc"):
         if not entry.isdigit() or int(entry) in skip:
             continue
         pid = int(entry)
-        if environment_of(pid).get("ROS_MASTER_URI") == master_uri and not _zombie(pid):
+        if environment_of(pid).get(name) == value and not _zombie(pid):
             found.append(pid)
     return sorted(found)
 
@@ -156,7 +162,13 @@ def describe(pids):
 def kill_leftovers(master_uri, exclude=(), timeout=5.0):
     """SIGTERM, then SIGKILL, to every process of the run still alive; returns the `ps`
     description of what was found (empty when nothing was)."""
-    pids = leftovers(master_uri, exclude)
+    return kill_tagged("ROS_MASTER_URI", master_uri, exclude, timeout)
+
+
+def kill_tagged(name, value, exclude=(), timeout=5.0):
+    """SIGTERM, then SIGKILL, to every live process whose environment has name=value (by
+    PID); returns the `ps` description of what was found (empty when nothing was)."""
+    pids = tagged(name, value, exclude)
     if not pids:
         return ""
     text = describe(pids)
@@ -167,9 +179,9 @@ def kill_leftovers(master_uri, exclude=(), timeout=5.0):
             except ProcessLookupError:
                 pass
         deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline and leftovers(master_uri, exclude):
+        while time.monotonic() < deadline and tagged(name, value, exclude):
             time.sleep(0.1)
-        pids = leftovers(master_uri, exclude)
+        pids = tagged(name, value, exclude)
         if not pids:
             break
     return text

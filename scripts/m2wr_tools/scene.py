@@ -26,7 +26,9 @@ from pybullet_gazebo.engine.sdf_world import load_world
 from pybullet_gazebo.engine.transforms import Pose, rotation_matrix
 from pybullet_gazebo.engine.world import World
 
-ROBOT = "m2wr"
+from .names import ROBOT
+
+SCAN_HEIGHT = 0.15           # [m] m2wr's laser plane above the ground, where obstacles are cut
 _PRISM_SIDES = 48            # a tilted cylinder is cut as this many-sided prism
 _FAR = 1.0e3                 # [m] the robot waits here until placed
 
@@ -132,6 +134,14 @@ class Scene:
         self.robot = self.world.spawn_urdf(robot, urdf_xml, Pose((0.0, 0.0, _FAR)))
         self._contact_links = {index for name, index in self.robot.links.items()
                                if name.endswith(wheel_contact.SUFFIX)}
+
+    @classmethod
+    def of_world(cls, world, urdf_xml=None):
+        """The scene of `world` (world01, world02 or a .world path) with m2wr (the URDF
+        xacro makes from m2wr_description, unless `urdf_xml` is given)."""
+        from . import paths
+        return cls(paths.world_path(world), paths.model_path(),
+                   urdf_xml if urdf_xml is not None else paths.robot_urdf())
 
     def close(self):
         try:

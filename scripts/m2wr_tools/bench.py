@@ -1,0 +1,218 @@
+"""Benchmark of the stand-in running the tutorial's episode 5 (world02, m2wr at (0, 8),
+obstacle_avoidance.py), printed side by side and written to <output>/bench.json.
+
+  scripts/bench.sh [--seconds 15] [--soak MINUTES] [--clock-hz 20] [--output output/]
+
+Figures:
+  whole loop        real-time factor of simulator + obstacle_avoidance.py, headless, with
+                    real_time_factor 0: free-running (lockstep false) and in lockstep, at the
+                    demo's /clock rate and at the simulator's default 100 Hz; CPU time of
+                    the simulator and of the controller per sim second; how often the robot
+                    touched a model (free-running, the controller's answers come late in sim
+                    time and the robot hits barriers: the reason lockstep exists)
+  lockstep check    scans published vs cmd_vel answers over a window that starts and ends
+                    paused (so no answer is in flight at either edge)
+  physics alone     the engine only (no ROS), world02 + m2wr: Bullet's stepSimulation, and
+                    World.step with the robot's drive, odometry and laser: steps/s, x real time
+  one scan          RaySensor.measure of the 720-beam laser in world02, mean over many
+  launch to scan    wall time from `roslaunch my_worlds launch_world.launch` to the first
+                    /m2wr/laser/scan, spawn.launch started right after it (own master up)
+  peak memory       VmHWM of the simulator process after the lockstep run
+  --soak MINUTES    lockstep loop for MINUTES of wall time: scan rate in sim time, missing
+                    scans, simulator RSS at start and end (growth %), ERROR lines in the logs
+  listeners         the lockstep loop again with a /gazebo/model_states subscriber,
+                    robot_state_publisher and /tf and /joint_states subscribers attached (what
+                    rviz and a Gazebo tool would add); printed as a ratio to the loop without,
+                    and the loop's ratio to World.step alone, both from the same run
+The machine is shared: the load average before and after is recorded with the figures.
+
+Where the simulator's time goes (profile recipe): run the loop (scripts/demo.sh, or
+`roslaunch my_worlds launch_world.launch gui:=false real_time_factor:=0 lockstep:=true`, spawn
+and the controller), then sample the simulator's main thread in wall time:
+  pip install py-spy   (not a dependency of the project)
+  py-spy record --idle --nonblocking -d 20 -f speedscope -o sim.json -p $(pgrep -f gazebo_world)
+and open sim.json in https://www.speedscope.app, thread "MainThread". --idle matters: without
+it, rospy's threads blocked in select/recv are not counted and the main thread's own waits
+(lockstep, time.sleep(0) in a queued publisher's write_data) are missed. Figures of issue 16
+(before DirectPublisher): Bullet's step 28 %, ray casting 13 %, /clock 14 %, scan 10 %,
+waiting for the controller 23 %; about 20 % was rospy's queued publish's time.sleep(0).
+"""
+import argparse
+import json
+import math
+import os
+import platform
+import signal
+import sys
+
+from . import benchmath
+from .bench_engine import engine_figures
+from .bench_loop import WORLD, START, Listener, launch_to_first_scan, measure_loop, say, soak
+from .benchmath import fmt
+from .paths import ROOT
+from .session import Session, SessionError
+
+SIMULATOR_DEFAULT_CLOCK_HZ = 100.0
+
+
+class Interrupted(Exception):
+    pass
+
+
+# --- the report ---------------------------------------------------------------------------
+def report(figures):
+    loops = figures["loop"]
+    names = list(loops)
+    rows = [
+        ("whole loop, x real time", [fmt(loops[n]["x_real_time"]) for n in names]),
+        ("  simulator CPU per sim s [ms]", [fmt(loops[n]["cpu_ms_per_sim_s"]["simulator"], "%.0f")
+                                           for n in names]),
+        ("  controller CPU per sim s [ms]", [fmt(loops[n]["cpu_ms_per_sim_s"]["controller"], "%.0f")
+                                            for n in names]),
+        ("robot touched a model (times)", [str(loops[n]["robot_touches"]) for n in names]),
+        ("scans published in the check window", [str(loops[n]["check"]["scans_published"])
+                                                 for n in names]),
+        ("  handled by the controller", [str(loops[n]["check"]["handled_by_controller"])
+                                         for n in names]),
+        ("  cmd_vel answers heard", [str(loops[n]["check"]["cmd_vel_answers"]) for n in names]),
+        ("controller received every scan", [("yes" if loops[n]["check"]["every_scan_received"]
+                                             else "no") for n in names]),
+        ("simulator peak RSS (VmHWM) [MiB]", [fmt(loops[n]["simulator_peak_rss_mib"])
+                                              for n in names]),
+    ]
+    lines = ["", "m2wr stand-in benchmark (%s, %d cores, load %s before, %s after)" % (
+        WORLD, figures["machine"]["cores"], figures["machine"]["load_before"],
+        figures["machine"]["load_after"]),
+        benchmath.table(names, [(label, *cells) for label, cells in rows])]
+    engine = figures["engine"]
+    lines += [
+        "",
+        "physics alone (engine, no ROS, step %g s):" % engine["step_size_s"],
+        "  Bullet stepSimulation             %8.0f steps/s  %6.1f x real time" % (
+            engine["physics_only"]["steps_per_s"], engine["physics_only"]["x_real_time"]),
+        "  World.step (+drive, odom, laser)  %8.0f steps/s  %6.1f x real time" % (
+            engine["engine_step"]["steps_per_s"], engine["engine_step"]["x_real_time"]),
+        "one 720-beam scan (RaySensor.measure) %6.3f ms mean of %d" % (
+            engine["scan"]["ms_mean"], engine["scan"]["scans"]),
+        "  the same beams by Bullet's rayTestBatch %6.3f ms" % engine["scan"]["bullet_ray_test_ms_mean"],
+    ]
+    lockstep = loops.get("lockstep", {}).get("x_real_time")
+    watched = loops.get("lockstep + listeners", {}).get("x_real_time")
+    step_alone = engine["engine_step"]["x_real_time"]
+    lines += [
+        "ratios (same run):",
+        "  lockstep loop with listeners / without   %s %% (target >= 90 %%)" % (
+            fmt(100.0 * watched / lockstep if lockstep and watched else None, "%.0f")),
+        "  lockstep loop / World.step alone         %s %% (target >= 60 %%)" % (
+            fmt(100.0 * lockstep / step_alone if lockstep and step_alone else None, "%.0f")),
+    ]
+    launch = figures.get("launch")
+    if launch:
+        lines.append("launch to first scan                  %6.2f s (simulator ready at %s s)" % (
+            launch["first_scan_s"], fmt(launch["simulator_ready_s"], "%.2f")))
+    soak_result = figures.get("soak")
+    if soak_result:
+        rss = soak_result["simulator_rss_mib"]
+        lines += [
+            "soak (%g min wall, %.0f s sim, %.1fx):" % (soak_result["minutes"], soak_result["sim_s"],
+                                                       soak_result["x_real_time"]),
+            "  scan rate %s Hz of sim time, %d missing; %d scans, %d handled, %d answers" % (
+                fmt(soak_result["scan_rate_hz_sim"], "%.3f"), soak_result["missing_scans"],
+                soak_result["scans"], soak_result["handled_by_controller"],
+                soak_result["cmd_vel_answers"]),
+            "  simulator RSS %s -> %s MiB (%s %%)" % (fmt(rss["start"]), fmt(rss["end"]),
+                                                     fmt(rss["growth_percent"], "%+.1f")),
+            "  ERROR lines in the logs: %d" % soak_result["error_lines"],
+        ]
+        lines += ["    " + line for line in soak_result["first_errors"]]
+    return "\n".join(lines)
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(prog="bench.sh", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--seconds", type=float, default=15.0,
+                        help="wall seconds of each real-time-factor measurement (default 15)")
+    parser.add_argument("--check-seconds", type=float, default=5.0,
+                        help="wall seconds of each scan/answer count (default 5)")
+    parser.add_argument("--clock-hz", type=float, default=20.0,
+                        help="/clock rate the demo uses [Hz sim] (default 20)")
+    parser.add_argument("--soak", type=float, default=0.0, metavar="MINUTES",
+                        help="also run a soak of MINUTES of wall time (default: none)")
+    parser.add_argument("--output", default=os.path.join(ROOT, "output"),
+                        help="folder for bench.json and logs (default output/)")
+    args = parser.parse_args(argv)
+    for name in ("seconds", "check_seconds", "clock_hz"):
+        if not (math.isfinite(getattr(args, name)) and getattr(args, name) > 0):
+            parser.error("--%s must be a number > 0" % name.replace("_", "-"))
+    if not (math.isfinite(args.soak) and args.soak >= 0):
+        parser.error("--soak must be a number of minutes >= 0")
+    return args
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    out = os.path.abspath(args.output)
+    os.makedirs(out, exist_ok=True)
+    session = Session(os.path.join(out, "logs", "bench"), name="m2wr_bench")
+
+    def interrupt(signum, _frame):
+        raise Interrupted(signal.Signals(signum).name)
+    signal.signal(signal.SIGINT, interrupt)
+    signal.signal(signal.SIGTERM, interrupt)
+
+    import pybullet
+    figures = {"machine": {"cores": os.cpu_count(), "load_before": "%.2f" % os.getloadavg()[0],
+                           "python": platform.python_version(),
+                           "pybullet": pybullet.getAPIVersion()},
+               "world": WORLD, "start": dict(zip(("x", "y", "yaw"), START)), "loop": {}}
+    status = 0
+    try:
+        say("engine alone (no ROS)")
+        figures["engine"] = engine_figures()
+        say("  stepSimulation %.1fx, World.step %.1fx real time, scan %.3f ms" % (
+            figures["engine"]["physics_only"]["x_real_time"],
+            figures["engine"]["engine_step"]["x_real_time"], figures["engine"]["scan"]["ms_mean"]))
+        session.start_master()
+        os.environ.update(ROS_MASTER_URI=session.master_uri, ROS_HOSTNAME="localhost")
+        import rospy
+        rospy.init_node("m2wr_bench", disable_signals=True)
+        listener = Listener()
+        loops = figures["loop"]
+        loops["free-running"] = measure_loop(session, listener, "free-running", False,
+                                             args.clock_hz, args.seconds, args.check_seconds)
+        loops["lockstep"] = measure_loop(session, listener, "lockstep", True, args.clock_hz,
+                                         args.seconds, args.check_seconds)
+        loops["lockstep + listeners"] = measure_loop(
+            session, listener, "lockstep + listeners", True, args.clock_hz, args.seconds,
+            args.check_seconds, watchers=True)
+        if args.clock_hz != SIMULATOR_DEFAULT_CLOCK_HZ:
+            loops["lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ] = measure_loop(
+                session, listener, "lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ, True,
+                SIMULATOR_DEFAULT_CLOCK_HZ, args.seconds, args.check_seconds)
+        figures["launch"] = launch_to_first_scan(session, listener, args.clock_hz)
+        if args.soak > 0:
+            figures["soak"] = soak(session, listener, args.soak, args.clock_hz)
+    except SessionError as err:
+        sys.stderr.write("bench: %s\n" % err)
+        status = 1
+    except Interrupted as err:
+        sys.stderr.write("bench: interrupted (%s); stopping everything\n" % err)
+        status = 130
+    except Exception as err:
+        sys.stderr.write("bench: %s: %s\n" % (type(err).__name__, err))
+        status = 1
+    finally:
+        session.shut_down("bench")
+    figures["machine"]["load_after"] = "%.2f" % os.getloadavg()[0]
+    figures["status"] = "ok" if status == 0 else "failed"
+    path = os.path.join(out, "bench.json")
+    with open(path, "w") as dump:
+        json.dump(figures, dump, indent=2, default=str)
+    if "engine" in figures:
+        print(report(figures) if figures["loop"] else "", flush=True)
+    say("figures written to %s" % path)
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,291 @@
+"""Evaluates a controller over many runs, in parallel on Dask:
+
+  scripts/evaluate.sh [--controller "rosrun motion_plan obstacle_avoidance.py" | PATH]
+                      [--task wander|goal|wall] [--goal X Y] [--world world02 ...]
+                      [--start X Y YAW ... | --grid STEP | --random N [--pose-seed S]]
+                      [--seeds 0 ...] [--duration 60] [--workers N | --scheduler tcp://H:P]
+                      [--output output/evaluate] [--no-reuse] [--bag] [--pictures] [--fresh]
+  scripts/evaluate.sh --bench [--bench-runs 20] [--duration 60]
+
+Runs every combination of world x start x seed (lockstep, headless, as fast as the machine
+allows; see m2wr_tools.rig for what one run does), then writes <output>/results.json and
+results.csv (one record a run: scenario, success and why, time to goal, distance, minimum
+clearance, contact events and time in contact, time stuck, path, final pose, wall time,
+real-time factor, the controller's exit status and log), prints the summary table, and draws
+<output>/trajectories_<world>.png and starts_<world>.png. Runs already in results.json are
+skipped (resume); --fresh starts over.
+
+Start poses: --start (repeatable), a --grid over free space, or --random N free poses drawn
+with --pose-seed; free = the robot's centre at least --margin m from every obstacle (the
+world file's geometry at scan height). Default: the tutorial's (0, 8, 0).
+
+--bench: the same --bench-runs runs (random free starts in world02, the tutorial's
+obstacle_avoidance.py, --duration s each) with 1 and 2 workers, each with and without
+simulator reuse; prints runs/min, the speed-up, the per-run overhead with reuse and the
+memory of the workers and simulators over the runs (figures printed, not asserted).
+
+Exit status: 0 when the batch finished (failed runs included); 1 when it could not run;
+2 for bad arguments; 130 when interrupted.
+"""
+import argparse
+import json
+import math
+import os
+import shlex
+import statistics
+import sys
+import time
+
+from . import results
+from .metrics import TASKS, Task
+from .names import DEFAULT_START, DEFAULT_WORLD, TUTORIAL_CONTROLLER
+from .paths import ROOT
+from .rig import RunOptions
+from .scenarios import FREE_MARGIN, check_starts, combinations, grid_starts, random_starts
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(prog="evaluate.sh", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--controller", default=" ".join(TUTORIAL_CONTROLLER),
+                        help="the controller: a command line (rosrun/roslaunch ...) or a path "
+                        "to a script (default: the tutorial's obstacle_avoidance.py)")
+    parser.add_argument("--task", choices=TASKS, default="wander",
+                        help="wander: no contact and --min-distance travelled over the "
+                        "duration; goal: reach --goal within --tolerance; wall: follow a wall")
+    parser.add_argument("--goal", type=float, nargs=2, metavar=("X", "Y"),
+                        help="goal [m] of the goal task (set as the des_pos_x/des_pos_y params)")
+    parser.add_argument("--tolerance", type=float, default=0.3, help="goal radius [m] (0.3)")
+    parser.add_argument("--min-distance", type=float, default=1.0,
+                        help="wander/wall: least distance [m] a successful run travels (1)")
+    parser.add_argument("--world", action="append", help="world01, world02 or a .world path "
+                        "(repeatable; default world02)")
+    parser.add_argument("--start", type=float, nargs=3, action="append",
+                        metavar=("X", "Y", "YAW"), help="a start pose [m m rad] (repeatable)")
+    parser.add_argument("--grid", type=float, metavar="STEP",
+                        help="starts on a grid of STEP m over free space (heading 0)")
+    parser.add_argument("--random", type=int, metavar="N", help="N random free start poses")
+    parser.add_argument("--pose-seed", type=int, default=0,
+                        help="seed of the --random poses (default 0)")
+    parser.add_argument("--margin", type=float, default=FREE_MARGIN,
+                        help="free space: least distance [m] of a start from any obstacle "
+                        "(default %g)" % FREE_MARGIN)
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0],
+                        help="simulator seeds (laser noise), one run each (default 0)")
+    parser.add_argument("--duration", type=float, default=60.0,
+                        help="sim time of a run [s] (default 60)")
+    parser.add_argument("--workers", type=int, help="LocalCluster workers (default: cores)")
+    parser.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. "
+                        "tcp://127.0.0.1:8786 (its workers need this project set up, "
+                        "scripts/env.sh sourced and --nthreads 1)")
+    parser.add_argument("--output", default=os.path.join(ROOT, "output", "evaluate"),
+                        help="folder of results, pictures and logs (default output/evaluate)")
+    parser.add_argument("--no-reuse", action="store_true",
+                        help="relaunch the simulator for every run")
+    parser.add_argument("--bag", action="store_true", help="a rosbag per run in <output>/runs/")
+    parser.add_argument("--pictures", action="store_true",
+                        help="the demo's picture per run in <output>/runs/")
+    parser.add_argument("--fresh", action="store_true",
+                        help="ignore the runs already in <output>/results.json")
+    parser.add_argument("--connect-timeout", type=float, default=20.0,
+                        help="wall seconds for the controller to publish cmd_vel (20)")
+    parser.add_argument("--run-timeout", type=float, default=0.0,
+                        help="wall seconds a run may take (default 60 + 2 x duration)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--bench", action="store_true", help="the batch benchmark (above)")
+    parser.add_argument("--bench-runs", type=int, default=20, help="runs of the benchmark (20)")
+    args = parser.parse_args(argv)
+    if not (math.isfinite(args.duration) and args.duration > 0):
+        parser.error("--duration must be > 0 seconds of sim time")
+    if args.workers is not None and args.workers < 1:
+        parser.error("--workers must be >= 1")
+    if sum(x is not None for x in (args.start, args.grid, args.random)) > 1:
+        parser.error("pass one of --start, --grid, --random")
+    if args.random is not None and args.random < 1:
+        parser.error("--random must be >= 1")
+    if args.task == "goal" and args.goal is None:
+        parser.error("--task goal needs --goal X Y")
+    if args.scheduler and not args.scheduler.startswith(("tcp://", "tls://", "inproc://")):
+        parser.error("--scheduler must be an address like tcp://127.0.0.1:8786")
+    args.world = args.world or [DEFAULT_WORLD]
+    return args
+
+
+def controller_argv(text):
+    """The controller's command line: a script path runs with this venv's python (if .py)
+    or as it is; anything else is split like a shell would."""
+    path = os.path.abspath(os.path.expanduser(text))
+    if os.path.isfile(path):
+        return (sys.executable, path) if path.endswith(".py") else (path,)
+    argv = tuple(shlex.split(text))
+    if not argv:
+        raise ValueError("--controller is empty; pass a command line or a script path")
+    return argv
+
+
+def build_scenarios(args, outlines_of):
+    task = Task(kind=args.task, goal=tuple(args.goal) if args.goal else None,
+                tolerance=args.tolerance, min_distance=args.min_distance)
+
+    def starts_of(world):
+        outlines = outlines_of(world)
+        if args.grid is not None:
+            return grid_starts(outlines, args.grid, margin=args.margin)
+        if args.random is not None:
+            return random_starts(outlines, args.random, args.pose_seed, margin=args.margin)
+        starts = [tuple(s) for s in args.start] if args.start else [DEFAULT_START]
+        check_starts(outlines, starts, margin=args.margin)
+        return starts
+    return combinations(args.world, starts_of, args.seeds, args.duration,
+                        controller_argv(args.controller), task)
+
+
+class _Outlines:
+    """The worlds' obstacle outlines at scan height, loaded once each (DIRECT client)."""
+
+    def __init__(self):
+        self.cache = {}
+
+    def __call__(self, world):
+        if world not in self.cache:
+            from .scene import SCAN_HEIGHT, Scene
+            scene = Scene.of_world(world)
+            try:
+                self.cache[world] = scene.outlines(SCAN_HEIGHT)
+            finally:
+                scene.close()
+        return self.cache[world]
+
+
+def say(text):
+    print("[evaluate] %s" % text, flush=True)
+
+
+def report(args, records, outlines_of, scenarios):
+    label = os.path.basename(scenarios[0].controller[-1]) if scenarios else ""
+    print(results.summary_table(records, title="%s, task %s, %g s sim each" % (
+        label, args.task, args.duration)), flush=True)
+    from . import batch_picture
+    pictures = []
+    for world in args.world:
+        label_world = scenarios[0].world_label if len(args.world) == 1 else \
+            os.path.basename(world).replace(".world", "")
+        runs = [r for r in records if r["scenario"]["world"] == world]
+        if not runs:
+            continue
+        title = "%s in %s: %d runs, %d succeeded (%s task, %g s)" % (
+            label, label_world, len(runs), sum(1 for r in runs if r.get("success")),
+            args.task, args.duration)
+        pictures.append(batch_picture.trajectories(
+            os.path.join(args.output, "trajectories_%s.png" % label_world),
+            outlines_of(world), runs, title))
+        pictures.append(batch_picture.starts(
+            os.path.join(args.output, "starts_%s.png" % label_world), outlines_of(world),
+            runs, title))
+    for path in pictures:
+        say("picture %s" % path)
+    say("results %s and results.csv" % os.path.join(args.output, "results.json"))
+
+
+def bench(args):
+    """Runs/min for 1 and 2 workers with and without reuse on the same runs."""
+    from .batch import run_batch
+    outlines_of = _Outlines()
+    args.world, args.random, args.start, args.grid = [DEFAULT_WORLD], args.bench_runs, None, None
+    scenarios = build_scenarios(args, outlines_of)
+    figures = {}
+    for workers, reuse in ((1, True), (2, True), (1, False), (2, False)):
+        name = "%d worker%s, %s" % (workers, "s" if workers > 1 else "",
+                                    "reuse" if reuse else "relaunch")
+        out = os.path.join(args.output, "bench", "w%d_%s" % (workers, "reuse" if reuse else "relaunch"))
+        say("bench: %s, %d runs of %g s" % (name, len(scenarios), args.duration))
+        t = time.monotonic()
+        records = run_batch(scenarios, RunOptions(output=out, reuse=reuse), workers=workers,
+                            resume=False, progress=not args.no_progress, say=say)
+        wall = time.monotonic() - t
+        overheads = [r["overhead_s"] / r["wall_time_s"] for r in records
+                     if r.get("overhead_s") is not None and r.get("reused")]
+        figures[name] = {"runs": len(records), "wall_s": wall,
+                         "runs_per_min": 60.0 * len(records) / wall,
+                         "failed": sum(1 for r in records if not r.get("success")),
+                         "overhead_share_median": statistics.median(overheads) if overheads else None,
+                         "overhead_s_median": statistics.median(
+                             [r["overhead_s"] for r in records if r.get("overhead_s") is not None
+                              and r.get("reused")] or [math.nan]),
+                         "memory": _memory(records)}
+        say("  %.2f runs/min" % figures[name]["runs_per_min"])
+    print("\nbatch benchmark: %d runs of %g s sim (world02, obstacle_avoidance.py, lockstep), "
+          "%d cores, load %.2f" % (len(scenarios), args.duration, os.cpu_count(),
+                                   os.getloadavg()[0]))
+    for name, f in figures.items():
+        overhead = "" if f["overhead_share_median"] is None else \
+            "  overhead with reuse %.2f s = %.0f %% of a run (median)" % (
+                f["overhead_s_median"], 100 * f["overhead_share_median"])
+        print("  %-22s %6.2f runs/min  (%.0f s wall, %d failed)%s" % (
+            name, f["runs_per_min"], f["wall_s"], f["failed"], overhead))
+    for mode in ("reuse", "relaunch"):
+        one, two = figures["1 worker, %s" % mode], figures["2 workers, %s" % mode]
+        print("  speed-up 2 vs 1 worker, %-8s %.2fx" % (mode, two["runs_per_min"] / one["runs_per_min"]))
+    for name, f in figures.items():
+        for worker, m in f["memory"].items():
+            print("  memory %-22s %s: worker %s MiB, simulator %s MiB (first -> last of %d runs)"
+                  % (name, worker, m["worker"], m["simulator"], m["runs"]))
+    path = os.path.join(args.output, "bench", "bench.json")
+    with open(path, "w") as out:
+        json.dump(figures, out, indent=1)
+    say("figures written to %s" % path)
+    return 0
+
+
+def _memory(records):
+    by_worker = {}
+    for r in sorted(records, key=lambda r: r.get("finished_at", 0)):
+        by_worker.setdefault(r.get("worker", "?"), []).append(r)
+    out = {}
+    for worker, runs in by_worker.items():
+        def span(key):
+            values = [r.get(key) for r in runs if r.get(key)]
+            return "%.0f -> %.0f" % (values[0], values[-1]) if values else "n/a"
+        out[worker] = {"worker": span("worker_rss_mib"), "simulator": span("simulator_rss_mib"),
+                       "runs": len(runs)}
+    return out
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    args.output = os.path.abspath(args.output)
+    from .batch import Interrupted, run_batch
+    try:
+        os.makedirs(args.output, exist_ok=True)
+        if args.bench:
+            return bench(args)
+        outlines_of = _Outlines()
+        try:
+            scenarios = build_scenarios(args, outlines_of)
+        except ValueError as err:
+            sys.stderr.write("evaluate: %s\n" % err)
+            return 2
+        say("%d runs: %d world(s) x %d start(s) x %d seed(s), %g s of sim time each" % (
+            len(scenarios), len(args.world), len(scenarios) // max(1, len(args.world) * len(args.seeds)),
+            len(args.seeds), args.duration))
+        options = RunOptions(output=args.output, reuse=not args.no_reuse, bag=args.bag,
+                             picture=args.pictures, connect_timeout=args.connect_timeout,
+                             run_timeout=args.run_timeout)
+        records = run_batch(scenarios, options, scheduler=args.scheduler, workers=args.workers,
+                            resume=not args.fresh, progress=not args.no_progress, say=say)
+        report(args, records, outlines_of, scenarios)
+        return 0
+    except Interrupted as err:
+        sys.stderr.write("evaluate: interrupted (%s); every process of the batch stopped; the "
+                         "runs done are in %s (run the same command again to resume)\n"
+                         % (err, os.path.join(args.output, "results.json")))
+        return 130
+    except KeyboardInterrupt:
+        sys.stderr.write("evaluate: interrupted\n")
+        return 130
+    except OSError as err:
+        sys.stderr.write("evaluate: %s\n" % err)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

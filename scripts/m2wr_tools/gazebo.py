@@ -1,0 +1,45 @@
+"""The tools' calls to the simulator's Gazebo services (a rospy node must be initialised):
+pause/unpause/reset (std_srvs/Empty), every model's pose, and placing a model."""
+from .names import GET_MODEL_STATE_SERVICE, SET_MODEL_STATE_SERVICE, WORLD_PROPERTIES_SERVICE
+
+
+def call_empty(name, timeout=10.0):
+    """Calls the std_srvs/Empty service `name`, waiting up to `timeout` [s] for it."""
+    import rospy
+    from std_srvs.srv import Empty
+    rospy.wait_for_service(name, timeout=timeout)
+    rospy.ServiceProxy(name, Empty)()
+
+
+def model_poses():
+    """{name: Pose} of every model, from /gazebo/get_world_properties and get_model_state."""
+    import rospy
+    from gazebo_msgs.srv import GetModelState, GetWorldProperties
+    from pybullet_gazebo.engine.transforms import Pose
+    names = rospy.ServiceProxy(WORLD_PROPERTIES_SERVICE, GetWorldProperties)().model_names
+    get = rospy.ServiceProxy(GET_MODEL_STATE_SERVICE, GetModelState)
+    poses = {}
+    for name in names:
+        state = get(name, "")
+        if state.success:
+            p, q = state.pose.position, state.pose.orientation
+            poses[name] = Pose((p.x, p.y, p.z), (q.x, q.y, q.z, q.w))
+    return poses
+
+
+def set_model_pose(name, x, y, z, yaw, timeout=10.0):
+    """Places model `name` at (x, y, z) [m] heading `yaw` [rad], at rest, through
+    /gazebo/set_model_state; RuntimeError with the simulator's answer when it refuses."""
+    import rospy
+    from gazebo_msgs.msg import ModelState
+    from gazebo_msgs.srv import SetModelState
+    from pybullet_gazebo.engine.transforms import quaternion_from_rpy
+    rospy.wait_for_service(SET_MODEL_STATE_SERVICE, timeout=timeout)
+    state = ModelState(model_name=name, reference_frame="world")
+    state.pose.position.x, state.pose.position.y, state.pose.position.z = x, y, z
+    q = quaternion_from_rpy(0.0, 0.0, yaw)
+    o = state.pose.orientation
+    o.x, o.y, o.z, o.w = q
+    answer = rospy.ServiceProxy(SET_MODEL_STATE_SERVICE, SetModelState)(state)
+    if not answer.success:
+        raise RuntimeError("set_model_state(%s) failed: %s" % (name, answer.status_message))

@@ -1,0 +1,451 @@
+"""The worker side of a batch: one simulator per worker process, and one run on it.
+
+A Rig owns a Session (its own ROS master on a free localhost port, `roslaunch my_worlds
+launch_world.launch` paused, headless, real_time_factor 0, lockstep) and a rospy node
+(/m2wr_batch) in the worker process. Every run takes the same path, so that its result
+depends only on its scenario:
+
+  stop the previous run's controller -> /gazebo/reset_simulation (sim time 0, every model
+  at its initial pose, the laser's noise generator re-seeded) -> /gazebo/set_model_state
+  m2wr at the start (z 0.5 m, at rest, as spawn.launch drops it) -> the recorder connected
+  -> the controller started and publishing cmd_vel -> physics unpaused for `duration` s of
+  sim time -> paused -> controller stopped -> metrics.
+
+The simulator is kept between runs of the same world and seed (reuse) and relaunched
+otherwise (the seed is a launch argument), or before every run with reuse off. The world and
+seed of a relaunch are the run's; the robot is spawned with spawn.launch once per launch.
+
+Topics in (the recorder): /tf (odom -> link_chassis: the trajectory; /odom's publisher keeps
+one message and drops under load, /tf's queues), /gazebo/contacts, /rosout_agg, /cmd_vel
+(answers counted). The simulator runs with lockstep_timeout 30 s (wall) instead of 1 s, so
+that a loaded machine cannot make it step on without the controller's answer.
+ROS params set for the controller: des_pos_x, des_pos_y, initial_x, initial_y [m] (the
+series' go_to_point/bug names) when the task is `goal`.
+
+A failed run (the controller crashed, never published cmd_vel, or the run overran its wall
+time limit; the simulator died) is returned as a record with success False and the reason;
+it never raises, so the batch goes on.
+"""
+from dataclasses import asdict, dataclass
+import atexit
+import math
+import os
+import shlex
+import signal
+import socket
+import subprocess
+import threading
+import time
+
+import numpy as np
+
+from . import metrics, processes
+from .gazebo import call_empty, model_poses, set_model_pose
+from .names import (BASE_FRAME, COMMAND_TOPIC, CONTACTS_TOPIC, ODOM_TOPIC, PAUSE_SERVICE,
+                    RESET_SIMULATION_SERVICE, ROBOT, SCAN_TOPIC, SIMULATOR_NODE, TF_TOPIC,
+                    UNPAUSE_SERVICE)
+from .scenarios import Scenario
+from .session import Session, SessionError
+
+NODE = "/m2wr_batch"
+SPAWN_Z = 0.5                 # [m] spawn.launch's default drop height of link_chassis
+PATH_PERIOD = 0.5             # [s] sim: the path kept in the results
+CLEARANCE_PERIOD = 0.1        # [s] sim: poses whose clearance is measured
+BATCH_TAG = "M2WR_BATCH"      # environment variable naming the batch every child belongs to
+
+
+@dataclass
+class RunOptions:
+    output: str                       # folder of the batch (logs/, runs/)
+    reuse: bool = True                # keep the simulator between runs of the same world/seed
+    lockstep: bool = True
+    clock_hz: float = 20.0            # [Hz sim] /clock rate
+    lockstep_timeout: float = 30.0    # [s wall] a busy machine may hold a controller's answer
+                                      # over the simulator's 1 s; a hung one hits run_timeout
+    connect_timeout: float = 20.0     # [s wall] for the controller to publish cmd_vel
+    run_timeout: float = 0.0          # [s wall] per run; 0: 60 + 2 x duration
+    bag: bool = False                 # rosbag per run: runs/<run_id>.bag
+    picture: bool = False             # the demo's picture per run: runs/<run_id>.png
+    batch: str = ""                   # the batch's tag (BATCH_TAG in every child's environment)
+
+
+class RunFailed(Exception):
+    """The run could not do its task; the message says why (and where the log is)."""
+
+
+class Rig:
+    def __init__(self):
+        self.session = None
+        self.key = None               # (world, seed, lockstep, clock_hz) of the running simulator
+        self.simulator_pid = None
+        self.recorder = None
+        self.commands = 0
+        self._command_sub = None
+        self.scenes = {}              # world -> scene.Scene (offline geometry)
+        self._executables = {}        # (package, name) -> path, for rosrun command lines
+        self.worker = "%s:%d" % (socket.gethostname(), os.getpid())
+
+    # --- the simulator ------------------------------------------------------------------
+    def _ensure_master(self, options):
+        if self.session is not None:
+            return
+        if options.batch:
+            os.environ[BATCH_TAG] = options.batch
+        log_dir = os.path.join(options.output, "logs", "worker-%s-%d" % (socket.gethostname(),
+                                                                        os.getpid()))
+        session = Session(log_dir, name=NODE.lstrip("/"))
+        try:
+            uri = session.start_master()
+        except SessionError:
+            session.stop_all()
+            raise
+        self.session = session
+        os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
+        os.environ.pop("ROS_IP", None)
+        import rospy
+        from geometry_msgs.msg import Twist
+        rospy.init_node(NODE.lstrip("/"), disable_signals=True)
+        self._command_sub = rospy.Subscriber(COMMAND_TOPIC, Twist, self._on_command,
+                                             queue_size=100, tcp_nodelay=True)
+
+    def _on_command(self, _msg):
+        self.commands += 1
+
+    def _ensure_simulator(self, scenario, options):
+        """True when the running simulator is reused; else (re)launches it."""
+        key = (scenario.world, scenario.seed, options.lockstep, options.clock_hz)
+        world = self.session.child("world")
+        if options.reuse and self.key == key and world is not None and world.running():
+            return True
+        self.session.stop(["controller", "rosbag", "spawn", "world"])
+        self.key = None
+        self.session.launch_world(scenario.world, real_time_factor=0.0, lockstep=options.lockstep,
+                                  seed=scenario.seed, paused=True,
+                                  pub_clock_frequency=options.clock_hz,
+                                  lockstep_timeout=options.lockstep_timeout)
+        self.session.wait_for_simulator()
+        self.session.spawn(scenario.x, scenario.y, scenario.yaw)
+        self.simulator_pid = self.session.node_pid(SIMULATOR_NODE)
+        self.key = key
+        return False
+
+    def _resolve(self, argv):
+        """`rosrun PKG EXECUTABLE ARGS` as the executable's own path (rosrun's bash and its
+        package search cost ~0.3 s a run); other command lines as given. A single argument
+        with spaces is split like a shell would."""
+        argv = tuple(argv)
+        if len(argv) == 1 and " " in argv[0]:
+            argv = tuple(shlex.split(argv[0]))
+        if len(argv) >= 3 and argv[0] == "rosrun":
+            key = argv[1:3]
+            if key not in self._executables:
+                found = subprocess.run(["catkin_find", "--first-only", argv[1], argv[2]],
+                                       stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                       text=True, env=self.session.env).stdout.strip()
+                self._executables[key] = found if found and os.access(found, os.X_OK) else None
+            if self._executables[key]:
+                return (self._executables[key],) + argv[3:]
+        return argv
+
+    def _scene(self, world):
+        if world not in self.scenes:
+            import rospy
+            from .scene import Scene
+            self.scenes[world] = Scene.of_world(world, rospy.get_param("/robot_description"))
+        return self.scenes[world]
+
+    # --- one run ------------------------------------------------------------------------
+    def run(self, scenario: Scenario, options: RunOptions):
+        """The run's record (a plain dict); never raises for a run that fails."""
+        wall0 = time.monotonic()
+        record = {"run_id": scenario.run_id, "scenario": scenario.as_dict(),
+                  "world": scenario.world_label, "x": scenario.x, "y": scenario.y,
+                  "yaw": scenario.yaw, "seed": scenario.seed, "task": scenario.task.kind,
+                  "worker": self.worker}
+        runs_dir = os.path.join(options.output, "runs")
+        os.makedirs(runs_dir, exist_ok=True)
+        log_path = os.path.join(runs_dir, scenario.run_id + ".log")
+        record.update(controller_log=log_path, controller_exit=None, reused=False)
+        try:
+            self._ensure_master(options)
+            record["reused"] = self._ensure_simulator(scenario, options)
+            record.update(self._run(scenario, options, log_path, runs_dir))
+        except RunFailed as err:
+            record.update(success=False, reason=str(err))
+            self.key = None       # the loop may still wait for that controller: relaunch
+        except SessionError as err:            # the simulator itself failed: relaunch next time
+            record.update(success=False, reason="simulator: %s" % err)
+            self.key = None
+        except Exception as err:               # a ROS call failed: say which
+            record.update(success=False, reason="%s: %s" % (type(err).__name__, err))
+            self.key = None
+        finally:
+            record["controller_exit"] = self._stop_controller(record.get("controller_exit"))
+        record["wall_time_s"] = time.monotonic() - wall0
+        record["finished_at"] = time.time()
+        sim = record.get("sim_time_s") or 0.0
+        unpaused = record.pop("_unpaused_wall_s", None)
+        record["real_time_factor"] = sim / unpaused if unpaused else None
+        record["overhead_s"] = record["wall_time_s"] - unpaused if unpaused else None
+        record["worker_rss_mib"] = (processes.rss_kib(os.getpid()) or 0) / 1024.0
+        sim_rss = processes.rss_kib(self.simulator_pid) if self.simulator_pid else None
+        record["simulator_rss_mib"] = sim_rss / 1024.0 if sim_rss else None
+        for name in ("success", "reason"):
+            record.setdefault(name, False if name == "success" else "")
+        return record
+
+    def _stop_controller(self, known_exit):
+        if self.session is None:
+            return known_exit
+        child = self.session.child("controller")
+        report = dict(self.session.stop(["controller", "rosbag"])) if child is not None else {}
+        self.session.stop_report.clear()
+        if known_exit is not None:
+            return known_exit
+        return report.get("controller", known_exit)
+
+    def _run(self, scenario, options, log_path, runs_dir):
+        import rospy
+        from .recorder import Recorder
+        session = self.session
+        stages, mark = {}, [time.monotonic()]
+
+        def stage(name):
+            now = time.monotonic()
+            stages[name] = round(now - mark[0], 3)
+            mark[0] = now
+        call_empty(PAUSE_SERVICE)
+        call_empty(RESET_SIMULATION_SERVICE)
+        set_model_pose(ROBOT, scenario.x, scenario.y, SPAWN_Z, scenario.yaw)
+        task = scenario.task
+        if task.kind == "goal":
+            for name, value in (("des_pos_x", task.goal[0]), ("des_pos_y", task.goal[1]),
+                                ("initial_x", scenario.x), ("initial_y", scenario.y)):
+                rospy.set_param("/" + name, float(value))
+        old, recorder = self.recorder, Recorder(poses_from_tf=BASE_FRAME)
+        if old is not None:
+            old.unregister()
+        self.recorder = recorder
+        self.commands = 0
+        self._wait(lambda: session.connected(SIMULATOR_NODE, TF_TOPIC, NODE)
+                   and session.connected(SIMULATOR_NODE, CONTACTS_TOPIC, NODE), 10.0,
+                   "the batch's recorder did not connect to the simulator")
+        stage("reset_s")
+        controller = session.start_controller(self._resolve(scenario.controller),
+                                              log_name=os.path.relpath(log_path[:-4], session.log_dir))
+        self._wait_for_controller(controller, options.connect_timeout, log_path)
+        stage("controller_start_s")
+        if options.bag:
+            session.start_bag(os.path.join(runs_dir, scenario.run_id + ".bag"),
+                              (SCAN_TOPIC, ODOM_TOPIC, COMMAND_TOPIC))
+            time.sleep(1.0)
+        limit = options.run_timeout or 60.0 + 2.0 * scenario.duration
+        recorder.fire_at(scenario.duration)
+        call_empty(UNPAUSE_SERVICE)
+        start = time.monotonic()
+        outcome = None
+        while not recorder.reached.wait(0.1):
+            if not controller.running():
+                outcome = "controller exited with status %s at %.2f s of sim time; see %s" % (
+                    controller.returncode, recorder.sim_time or 0.0, log_path)
+                break
+            session.check_running(["world"])
+            if task.kind == "goal" and recorder.poses:
+                last = recorder.poses[-1]
+                if math.hypot(last[1] - task.goal[0], last[2] - task.goal[1]) <= task.tolerance:
+                    break
+            if time.monotonic() - start > limit:
+                outcome = ("did not finish within %.0f s of wall time (sim time %.2f of %.0f s; "
+                           "lockstep waits for the controller's answers: a hung controller "
+                           "stalls it); see %s" % (limit, recorder.sim_time or 0.0,
+                                                  scenario.duration, log_path))
+                break
+        call_empty(PAUSE_SERVICE)
+        unpaused = time.monotonic() - start
+        stage("sim_s")
+        exit_status = None
+        if not controller.running():
+            exit_status = "exit %s" % controller.returncode
+        else:
+            # Lockstep may be holding the loop for the answer to the last scan: once it comes,
+            # the loop takes its last step and idles. Stopping the controller before that
+            # would leave the loop waiting, and its last step would land in the next run.
+            self._wait_quiet()
+            controller.signal_group(signal.SIGINT)     # it ends while the run is measured
+        time.sleep(0.2)                       # the last messages arrive (physics is paused)
+        if outcome is None and self.commands == 0:
+            outcome = "the controller never published on %s; see %s" % (COMMAND_TOPIC, log_path)
+        result = self._measure(scenario, recorder, options, runs_dir)
+        stage("measure_s")
+        result["stages"] = stages
+        result["_unpaused_wall_s"] = unpaused
+        result["cmd_vel_messages"] = self.commands
+        if exit_status is not None:
+            result["controller_exit"] = exit_status
+        if outcome is not None:
+            result.update(success=False, reason=outcome)
+            self.key = None       # the loop may still wait for that controller: relaunch
+        return result
+
+    def _wait_quiet(self, quiet=0.25, timeout=5.0):
+        """Until no cmd_vel has come for `quiet` [s] of wall time (at most `timeout`)."""
+        deadline = time.monotonic() + timeout
+        count, since = self.commands, time.monotonic()
+        while time.monotonic() < deadline:
+            time.sleep(0.05)
+            if self.commands != count:
+                count, since = self.commands, time.monotonic()
+            elif time.monotonic() - since >= quiet:
+                return
+
+    def _wait(self, condition, timeout, what):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if condition():
+                return
+            time.sleep(0.02)
+        raise SessionError("%s within %.0f s" % (what, timeout))
+
+    def _wait_for_controller(self, controller, timeout, log_path, settle=0.3):
+        """Until a node other than the batch's publishes cmd_vel to the simulator, and every
+        topic of the simulator it subscribes to is connected, unchanged for `settle` [s]
+        (a program may subscribe after it advertises, as obstacle_avoidance.py does)."""
+        master = self.session.master()
+        deadline = time.monotonic() + timeout
+        ready_since, last = None, None
+        while time.monotonic() < deadline:
+            if not controller.running():
+                raise RunFailed("controller exited with status %s while starting; see %s:\n%s"
+                                % (controller.returncode, log_path, controller.log_tail(8)))
+            try:
+                _, _, (publishers, subscribers, _) = master.getSystemState(NODE)
+            except OSError:
+                publishers, subscribers = [], []
+            simulator_topics = {t for t, names in publishers if SIMULATOR_NODE in names}
+            nodes = {n for topic, names in publishers if topic == COMMAND_TOPIC for n in names
+                     if n != NODE}
+            wanted = sorted((n, t) for t, names in subscribers if t in simulator_topics
+                            for n in names if n in nodes)
+            ready = any(self.session.connected(SIMULATOR_NODE, COMMAND_TOPIC, n) for n in nodes) \
+                and all(self.session.connected(SIMULATOR_NODE, t, n) for n, t in wanted)
+            if ready and wanted == last:
+                ready_since = ready_since or time.monotonic()
+                if time.monotonic() - ready_since >= settle:
+                    return
+            else:
+                ready_since = None
+            last = wanted
+            time.sleep(0.05)
+        raise RunFailed("the controller published no %s within %.0f s of wall time (it is "
+                        "running; see %s)" % (COMMAND_TOPIC, timeout, log_path))
+
+    def _measure(self, scenario, recorder, options, runs_dir):
+        """The run's metrics over [0, duration] of sim time."""
+        from pybullet_gazebo.engine.transforms import Pose, yaw_from_quaternion
+        task, duration = scenario.task, scenario.duration
+        rows = [(p[0], p[1], p[2], yaw_from_quaternion(p[4:8]), *p[3:8]) for p in recorder.poses]
+        track = metrics.clip_track(np.array(rows).reshape(-1, 9), duration)
+        if not len(track):
+            raise RunFailed("no odometry was heard during the run")
+        end = float(track[-1, 0])
+        events, touching = metrics.contact_figures(recorder.contacts, duration)
+        goal_time = metrics.time_to_goal(track, task.goal, task.tolerance) \
+            if task.kind == "goal" else None
+        sampled = metrics.decimate(track, CLEARANCE_PERIOD)
+        scene = self._scene(scenario.world)
+        try:
+            if events:
+                scene.set_model_poses({n: p for n, p in model_poses().items() if n != ROBOT})
+            poses = [Pose(tuple(r[1:3]) + (r[4],), tuple(r[5:9])) for r in sampled]
+            clearances = scene.clearance(poses, max_distance=50.0)
+        finally:
+            scene.world.reset_world()
+        distances = np.array([c.distance for c in clearances])
+        nearest = clearances[int(np.argmin(distances))] if len(clearances) else None
+        wall_share = metrics.fraction_within(distances, task.wall_near, task.wall_far)
+        distance = metrics.distance(track[:, 1:3])
+        success, reason = metrics.judge(task, distance, events, goal_time, wall_share)
+        path = metrics.decimate(track, PATH_PERIOD)
+        result = {
+            "success": success, "reason": reason, "sim_time_s": end,
+            "time_to_goal_s": goal_time, "distance_m": distance,
+            "min_clearance_m": metrics.finite_or_none(nearest.distance) if nearest else None,
+            "min_clearance_model": nearest.model if nearest else "",
+            "contact_events": events, "time_in_contact_s": touching,
+            "time_stuck_s": metrics.stuck_time(track),
+            "wall_share": wall_share if task.kind == "wall" else None,
+            "final_x": float(track[-1, 1]), "final_y": float(track[-1, 2]),
+            "final_yaw": float(track[-1, 3]),
+            "path": [[round(float(t), 3), round(float(x), 4), round(float(y), 4)]
+                     for t, x, y in path[:, :3]],
+            "cases_s": _case_shares(recorder.cases, duration),
+        }
+        if options.bag:
+            result["bag"] = os.path.join(runs_dir, scenario.run_id + ".bag")
+        if options.picture:
+            result["picture"] = self._picture(scenario, track, scene, runs_dir)
+        return result
+
+    def _picture(self, scenario, track, scene, runs_dir):
+        from . import picture
+        from .scene import SCAN_HEIGHT
+        path = os.path.join(runs_dir, scenario.run_id + ".png")
+        picture.draw(path, scene.outlines(SCAN_HEIGHT), track[:, 0], track[:, 1], track[:, 2],
+                     track[:, 3], title="%s: %s from (%.2f, %.2f), yaw %.0f deg, seed %d" % (
+                         scenario.world_label, os.path.basename(scenario.controller[-1]),
+                         scenario.x, scenario.y, math.degrees(scenario.yaw), scenario.seed))
+        return path
+
+    # --- the end ------------------------------------------------------------------------
+    def close(self):
+        for scene in self.scenes.values():
+            scene.close()
+        self.scenes.clear()
+        if self.session is not None:
+            try:
+                import rospy
+                if rospy.core.is_initialized():
+                    rospy.signal_shutdown("batch worker closing")
+            except ImportError:
+                pass
+            # quick: a closing Dask worker may be killed a few seconds later
+            children = list(self.session.children.values())
+            processes.stop(children, sigint_timeout=3.0, sigterm_timeout=2.0)
+            if self.session.master_uri:
+                processes.kill_leftovers(self.session.master_uri)
+            self.session = None
+
+
+def _case_shares(cases, duration):
+    from .summary import case_durations
+    return case_durations(cases, 0.0, duration)
+
+
+# --- the Dask task --------------------------------------------------------------------
+_RIG = None
+_LOCK = threading.Lock()          # one run at a time per worker process (one master, one node)
+
+
+def run_scenario(scenario, options):
+    """Dask task: runs `scenario` (Scenario.as_dict()) with `options` (RunOptions as a dict)
+    on this process's rig; returns the record."""
+    global _RIG
+    with _LOCK:
+        if _RIG is None:
+            _RIG = Rig()
+            atexit.register(close_rig)
+        return _RIG.run(Scenario.from_dict(scenario), RunOptions(**options))
+
+
+def close_rig():
+    """Stops this process's rig (its simulator, controller and master), if any."""
+    global _RIG
+    with _LOCK:
+        if _RIG is not None:
+            _RIG.close()
+            _RIG = None
+
+
+def options_dict(options: RunOptions):
+    return asdict(options)
+

@@ -1,0 +1,118 @@
+"""Helpers of the batch runner's integration tests: running scripts/evaluate.sh, a real Dask
+scheduler and workers as separate processes on 127.0.0.1 (stopped by PID), and checks of a
+results file against world02's geometry."""
+import json
+import os
+import subprocess
+import time
+
+import pytest
+
+from m2wr_tools import processes
+from m2wr_tools.paths import ROOT
+
+EVALUATE = os.path.join(ROOT, "scripts", "evaluate.sh")
+FIXTURES = os.path.join(ROOT, "scripts", "test", "fixtures")
+DURATION = 20.0              # [s] of sim time a run: short, the suite stays fast
+WORLD02_BOUNDS = (-10.5, -10.5, 10.5, 10.5)   # [m] world02's walls enclose this square
+
+
+def evaluate(args, output, timeout=420):
+    """Runs scripts/evaluate.sh with `args`; returns (exit status, output text, results)."""
+    command = ["bash", EVALUATE, "--output", str(output), "--no-progress",
+               "--duration", "%g" % DURATION] + list(args)
+    done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          timeout=timeout, stdin=subprocess.DEVNULL)
+    path = os.path.join(str(output), "results.json")
+    data = {"runs": []}
+    if os.path.exists(path):
+        with open(path) as source:
+            data = json.load(source)
+    return done.returncode, done.stdout, data
+
+
+class DaskProcesses:
+    """`dask scheduler` and `dask worker` processes, each in its own process group."""
+
+    def __init__(self, log_dir):
+        self.log_dir = str(log_dir)
+        self.children = []
+        self.port = processes.free_port()
+        self.address = "tcp://127.0.0.1:%d" % self.port
+
+    def start_scheduler(self):
+        self._start("scheduler", ["dask", "scheduler", "--host", "127.0.0.1", "--port",
+                                  str(self.port), "--no-dashboard", "--no-show"])
+
+    def start_worker(self, name):
+        self._start(name, ["dask", "worker", self.address, "--nthreads", "1", "--nworkers", "1",
+                           "--host", "127.0.0.1", "--no-dashboard", "--name", name,
+                           "--no-nanny"])
+
+    def _start(self, name, argv):
+        env = dict(os.environ)
+        self.children.append(processes.Child(name, argv, env,
+                                             os.path.join(self.log_dir, name + ".log")))
+
+    def wait_for_workers(self, count, timeout=90.0):
+        """Until the scheduler's log shows `count` workers registered."""
+        scheduler = self.children[0]
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            for child in self.children:
+                if not child.running():
+                    raise AssertionError("%s exited (%s):\n%s" % (child.name, child.returncode,
+                                                                   child.log_tail()))
+            if scheduler.log_tail(400).count("Register worker") >= count:
+                return
+            time.sleep(0.5)
+        raise AssertionError("the scheduler did not see %d workers within %.0f s:\n%s"
+                             % (count, timeout, scheduler.log_tail()))
+
+    def stop(self):
+        """Workers first (they stop their simulators), then the scheduler."""
+        workers = [c for c in self.children if c.name != "scheduler"]
+        outcome = processes.stop(workers, sigint_timeout=30.0, sigterm_timeout=5.0)
+        outcome.update(processes.stop([c for c in self.children if c.name == "scheduler"],
+                                      sigint_timeout=10.0))
+        self.children = []
+        return outcome
+
+
+@pytest.fixture
+def dask_cluster(tmp_path):
+    cluster = DaskProcesses(tmp_path / "dask")
+    try:
+        cluster.start_scheduler()
+        cluster.start_worker("worker-1")
+        cluster.start_worker("worker-2")
+        cluster.wait_for_workers(2)
+        yield cluster
+    finally:
+        cluster.stop()
+
+
+def batch_tag(data):
+    return data.get("batch", {}).get("options", {}).get("batch", "")
+
+
+def assert_no_process_left(data):
+    """No process of the batch (tagged M2WR_BATCH) is alive; kills any found, by PID."""
+    tag = batch_tag(data)
+    assert tag, "results.json names no batch tag"
+    deadline = time.monotonic() + 10.0
+    while processes.tagged("M2WR_BATCH", tag) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    left = processes.kill_tagged("M2WR_BATCH", tag)
+    assert not left, "processes of the batch still running:\n%s" % left
+
+
+@pytest.fixture
+def run_evaluate():
+    """evaluate(args, output) -> (exit status, output text, results.json's content)."""
+    return evaluate
+
+
+@pytest.fixture
+def no_process_left():
+    return assert_no_process_left

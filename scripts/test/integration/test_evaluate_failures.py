@@ -1,0 +1,34 @@
+"""scripts/evaluate.sh with controllers that fail: one that exits 1 at once and one that
+never publishes on /cmd_vel. Each run is marked failed with the reason and the controller's
+log, the batch finishes (exit 0, every run in the results) and no process is left."""
+import os
+
+from m2wr_tools.paths import ROOT
+
+FIXTURES = os.path.join(ROOT, "scripts", "test", "fixtures")
+
+
+def test_crashing_and_silent_controllers_fail_their_runs_not_the_batch(tmp_path, run_evaluate,
+                                                                       no_process_left):
+    status, text, data = run_evaluate(
+        ["--controller", os.path.join(FIXTURES, "crash_controller.py"), "--workers", "1",
+         "--start", "0", "8", "0", "--start", "-3", "2", "1"], tmp_path / "crash")
+    assert status == 0, text
+    assert len(data["runs"]) == 2
+    for r in data["runs"]:
+        assert r["success"] is False
+        assert r["reason"].startswith("controller exited with status 1 while starting"), r["reason"]
+        with open(r["controller_log"]) as log:
+            assert "giving up on purpose" in log.read()
+    assert "2 x controller exited with status 1 while starting" in text
+    no_process_left(data)
+
+    status, text, data = run_evaluate(
+        ["--controller", os.path.join(FIXTURES, "silent_controller.py"), "--workers", "1",
+         "--connect-timeout", "5"], tmp_path / "silent")
+    assert status == 0, text
+    [r] = data["runs"]
+    assert r["success"] is False
+    assert r["reason"].startswith("the controller published no /cmd_vel within 5 s"), r["reason"]
+    assert os.path.exists(r["controller_log"])
+    no_process_left(data)

@@ -1,0 +1,48 @@
+"""The command line of evaluate.sh (m2wr_tools.evaluate): defaults, options, bad input."""
+import sys
+
+import pytest
+
+from m2wr_tools import evaluate
+
+
+def test_defaults_are_the_tutorials_program_in_world02():
+    args = evaluate.parse_args([])
+    assert args.world == ["world02"] and args.task == "wander" and args.duration == 60.0
+    assert args.seeds == [0] and args.scheduler is None and not args.no_reuse
+    assert evaluate.controller_argv(args.controller) == ("rosrun", "motion_plan",
+                                                         "obstacle_avoidance.py")
+
+
+def test_options():
+    args = evaluate.parse_args(["--world", "world01", "--world", "world02", "--random", "40",
+                                "--pose-seed", "2", "--seeds", "0", "1", "--duration", "30",
+                                "--scheduler", "tcp://127.0.0.1:8786", "--task", "goal",
+                                "--goal", "2", "-3"])
+    assert args.world == ["world01", "world02"] and args.random == 40 and args.seeds == [0, 1]
+    assert args.goal == [2.0, -3.0] and args.scheduler == "tcp://127.0.0.1:8786"
+
+
+def test_a_script_path_runs_with_this_python(tmp_path):
+    script = tmp_path / "mine.py"
+    script.write_text("print('hi')\n")
+    assert evaluate.controller_argv(str(script)) == (sys.executable, str(script))
+    assert evaluate.controller_argv("roslaunch my_pkg my.launch x:=1") == (
+        "roslaunch", "my_pkg", "my.launch", "x:=1")
+    with pytest.raises(ValueError, match="--controller is empty"):
+        evaluate.controller_argv("  ")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--duration", "0"], "--duration must be > 0"),
+    (["--workers", "0"], "--workers must be >= 1"),
+    (["--grid", "1", "--random", "3"], "pass one of --start, --grid, --random"),
+    (["--task", "goal"], "--task goal needs --goal"),
+    (["--scheduler", "localhost:8786"], "--scheduler must be an address like tcp://"),
+    (["--task", "dance"], "invalid choice"),
+])
+def test_bad_arguments_are_named(argv, message, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        evaluate.parse_args(argv)
+    assert exit_info.value.code == 2
+    assert message in capsys.readouterr().err
