@@ -235,14 +235,7 @@ class World:
     def spawn_urdf(self, name: str, urdf_xml: str, pose: Pose, namespace: str = "") -> Robot:
         """Loads a URDF robot at `pose` (its root link frame, world) with the parts its
         `<gazebo>` tags ask for. Raises SpawnError (world unchanged) when it cannot."""
-        if not name or not name.strip():
-            raise SpawnError("model name is empty; pass -model NAME")
-        if name in self.entities:
-            raise SpawnError("SpawnModel: Failure - entity already exists: model '%s' is in the "
-                             "world; delete it first or choose another -model name" % name)
-        pose = checked_pose(pose, "spawn pose of '%s'" % name,
-                            "pass finite -x -y -z within the world and a unit quaternion "
-                            "(or -R -P -Y)", error=SpawnError)
+        pose = self._checked_new_model(name, pose)
         try:
             spec = parse_robot(urdf_xml, name)
         except Exception as err:   # the parser names what is wrong with the description
@@ -273,19 +266,23 @@ class World:
         self.caster.add_body(body, static=False)
         return robot
 
-    def spawn_sdf(self, name: str, sdf_xml: str, pose: Pose, model_path=()):
-        """Adds the `<sdf><model>` (or `<sdf><include>`) of `sdf_xml` as model `name`, its
-        model frame at `pose` (world), as Gazebo's spawn_sdf_model does. Links with box,
-        cylinder, sphere or plane collisions become bodies; meshes are reported and left out.
-        Raises SpawnError (world unchanged) when it cannot."""
+    def _checked_new_model(self, name, pose) -> Pose:
+        """The spawn pose, normalised; SpawnError for an empty or taken name or a bad pose."""
         if not name or not name.strip():
             raise SpawnError("model name is empty; pass -model NAME")
         if name in self.entities:
             raise SpawnError("SpawnModel: Failure - entity already exists: model '%s' is in the "
                              "world; delete it first or choose another -model name" % name)
-        pose = checked_pose(pose, "spawn pose of '%s'" % name,
+        return checked_pose(pose, "spawn pose of '%s'" % name,
                             "pass finite -x -y -z within the world and a unit quaternion "
                             "(or -R -P -Y)", error=SpawnError)
+
+    def spawn_sdf(self, name: str, sdf_xml: str, pose: Pose, model_path=()):
+        """Adds the `<sdf><model>` (or `<sdf><include>`) of `sdf_xml` as model `name`, its
+        model frame at `pose` (world), as Gazebo's spawn_sdf_model does. Links with box,
+        cylinder, sphere or plane collisions become bodies; meshes are reported and left out.
+        Raises SpawnError (world unchanged) when it cannot."""
+        pose = self._checked_new_model(name, pose)
         try:
             model, warnings = load_model_text(sdf_xml, model_path)
         except ValueError as err:
