@@ -30,8 +30,10 @@ SPINNING_FRICTION = 0.001      # [m] Bullet's spinning-friction lever
 # step adds up, and a robot at rest slid sideways at 5e-7 m/s. A friction anchor also pulls
 # the contact back to where it started sticking (a position correction), as a tyre that does
 # not slip stays put: the drift falls to 1e-11 m/s (the drive's wheel hold does the same for
-# rolling, see diff_drive._hold).
-FRICTION_ANCHOR = 1
+# rolling, see diff_drive._hold). Anchors make each step about 60 us dearer (world02 + m2wr:
+# 165 instead of 100 us), so they are off here and the diff drive turns them on only while
+# the robot is told to stand still (DiffDrive._anchor).
+FRICTION_ANCHOR = 0
 
 
 def add_contact_links(root, wheel_links):
