@@ -10,8 +10,8 @@ controller has answered (a command counted since that scan), at most `timeout` w
 The answer then reaches the wheels at the same sim time on every run.
 
 Controllers that publish from their own loop (rospy.Rate, as the series' later programs do)
-wake on /clock, not on scans: before waiting, `before_wait` is called (the node brings /clock
-up to now), so a loop whose tick fell since the last /clock publishes its command before the
+wake on /clock, not on scans: when no answer came within WAKE_AFTER of wall time,
+`before_wait` is called (the node brings /clock up to now), so a loop whose tick fell since the last /clock publishes its command before the
 drive reads it. When no command comes within `timeout` (every controller switched off, say),
 lockstep reports it once and stops waiting until the next command arrives, instead of
 stalling `timeout` at every scan.
@@ -42,6 +42,8 @@ class RealTimePacer:
 
 
 class Lockstep:
+    WAKE_AFTER = 0.005        # [s] wall: how long an answer may take before the wake-up /clock
+
     def __init__(self, enabled, timeout, on_timeout, is_shutdown, before_wait=lambda: None):
         self.enabled = enabled
         self.timeout = timeout               # [s] wall
@@ -77,13 +79,23 @@ class Lockstep:
         if self.commands != awaited[0] or self.commands == self.silent_at \
                 or not anyone_commands():
             return                  # answered already, controllers silent, or none at all
-        self.before_wait()
         deadline = time.monotonic() + self.timeout
+        # a controller that answers scans is usually a few ms away: no wake-up /clock for it
+        # (each /clock wakes every node); one on its own loop gets it after WAKE_AFTER
+        if self._wait_for(awaited[0], min(deadline, time.monotonic() + self.WAKE_AFTER)):
+            return
+        self.before_wait()
+        if not self._wait_for(awaited[0], deadline):
+            self.silent_at = self.commands
+            self.on_timeout()
+
+    def _wait_for(self, commands_before, deadline):
+        """Waits until a command beyond `commands_before` came (True) or the wall clock
+        reached `deadline` (False)."""
         with self._arrived:
-            while self.commands == awaited[0] and not self.is_shutdown():
+            while self.commands == commands_before and not self.is_shutdown():
                 left = deadline - time.monotonic()
                 if left <= 0:
-                    self.silent_at = self.commands
-                    self.on_timeout()
-                    return
+                    return False
                 self._arrived.wait(min(left, 0.1))
+        return True
