@@ -218,6 +218,26 @@ def test_same_seed_and_commands_give_identical_runs(make_world, m2wr_urdf):
     assert not np.array_equal(scans_a, scans_c)             # the noise follows the seed
 
 
+def test_a_run_after_reset_simulation_repeats_the_first(make_world, m2wr_urdf):
+    """What a batch or a Gym episode does: the same commands after reset_simulation give the
+    same trajectory (the drive's standing state, e.g. its friction anchors, starts over)."""
+    world = make_world("world02", seed=3)
+    robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(0, 8, 0.5))
+    drive = component(robot, DiffDrive)
+
+    def trajectory():
+        poses = []
+        for second in range(4):        # lands and stands, drives, stands, turns
+            drive.set_command(0.5 if second % 2 == 1 else 0.0, 0.4 if second == 3 else 0.0)
+            run(world, 0.5)
+            poses.append(world.model_pose("m2wr"))
+        return poses
+
+    first = trajectory()
+    world.reset_simulation()
+    assert trajectory() == first
+
+
 def test_dynamic_world_models_keep_their_sdf_mass_and_inertia_and_stay_at_rest(make_world):
     world = make_world("world02")
     dynamic = [m for m in world_spec("world02").models if not m.static]

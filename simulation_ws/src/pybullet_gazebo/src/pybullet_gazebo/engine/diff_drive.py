@@ -95,21 +95,24 @@ class DiffDrive(Part):
 
     @classmethod
     def build(cls, context: PartContext, plugin):
-        drive = cls(context.client, context.body_id, context.joints, plugin, context.warn,
-                    command_timeout=context.command_timeout,
-                    legacy_mode_swaps=context.legacy_mode_swaps,
-                    kinetic_legacy_mode=context.kinetic_legacy_mode)
         # the wheels' ground-contact spheres (wheel_contact), anchored while the robot stands
         joints = context.description.joints
-        drive.anchor_links = [
-            context.links[contact] for name in (drive.left_joint, drive.right_joint)
-            for contact in (joints[name][1] + wheel_contact.SUFFIX,) if name in joints
-            and contact in context.links]
-        return drive
+        anchor_links = []
+        for tag, default in (("leftJoint", "left_joint"), ("rightJoint", "right_joint")):
+            joint = plugin.params.get(tag, default).strip()
+            contact = joints[joint][1] + wheel_contact.SUFFIX if joint in joints else None
+            if contact in context.links:
+                anchor_links.append(context.links[contact])
+        return cls(context.client, context.body_id, context.joints, plugin, context.warn,
+                   command_timeout=context.command_timeout,
+                   legacy_mode_swaps=context.legacy_mode_swaps,
+                   kinetic_legacy_mode=context.kinetic_legacy_mode, anchor_links=anchor_links)
 
     def __init__(self, client, body_id, joints, plugin, warn, command_timeout=0.0,
-                 legacy_mode_swaps=False, kinetic_legacy_mode=False):
-        self.anchor_links = []      # Bullet links whose friction anchors hold a standing robot
+                 legacy_mode_swaps=False, kinetic_legacy_mode=False, anchor_links=()):
+        # Bullet links whose friction anchors hold a standing robot; set before reset(),
+        # which stands the robot (and so anchors it) from the first step on, as after a reset
+        self.anchor_links = list(anchor_links)
         self._anchored = None
         self._client = client
         self.body_id = body_id
