@@ -34,6 +34,8 @@ APT_PACKAGES=(
   python3-tf joint-state-publisher tf2-tools
   # gazebo_msgs' SetJointTrajectory; Gazebo's physics dynamic_reconfigure server
   ros-trajectory-msgs libtrajectory-msgs-dev python3-trajectory-msgs python3-dynamic-reconfigure
+  # a real window for the GUI's tests on a machine with no display (Xvfb)
+  xvfb
 )
 
 STEP="check machine"

@@ -3,9 +3,11 @@
 every time, while it steps as fast as it can. Each run starts gazebo_world on world02 in a
 namespace of its own (on this test's master), waits until it publishes, signals its whole
 process group (as a terminal's Ctrl-C does) at a varying moment, and reads its output.
-With a display (DISPLAY set, e.g. under Xvfb) the same is done with the GUI on."""
+The same is done with the GUI on, in a real window: on the user's display when DISPLAY is
+set, else on an Xvfb server this test starts and stops (setup.sh installs Debian's xvfb)."""
 import os
 import random
+import shutil
 import signal
 import subprocess
 import tempfile
@@ -21,19 +23,46 @@ RUNS_SIGTERM = 2
 EXIT_WITHIN = 10.0          # [s] wall from the signal to the process's exit
 
 
+class VirtualDisplay:
+    """An Xvfb server on a free display number (Xvfb picks it: -displayfd), stopped by PID."""
+
+    def __init__(self):
+        read_end, write_end = os.pipe()
+        self.process = subprocess.Popen(
+            ["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24",
+             "-nolisten", "tcp"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL, start_new_session=True)
+        os.close(write_end)
+        with os.fdopen(read_end) as pipe:
+            number = pipe.readline().strip()       # written once the server accepts clients
+        if not number:
+            self.stop()
+            raise AssertionError("Xvfb did not start")
+        self.display = ":" + number
+
+    def stop(self):
+        if self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(10)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+
+
 class CleanShutdownTest(unittest.TestCase):
     def setUp(self):
         self.master = rosgraph.Master("/test_clean_shutdown")
         self.worlds = os.path.join(rospkg.RosPack().get_path("my_worlds"), "worlds")
         self.rng = random.Random(7)
 
-    def run_and_signal(self, run, signum, gui):
+    def run_and_signal(self, run, signum, gui, env=None):
         namespace = "/shutdown_%d_%d" % (os.getpid(), run)
         output = tempfile.TemporaryFile(mode="w+")
         node = subprocess.Popen(
             ["rosrun", "pybullet_gazebo", "gazebo_world", "world02", "--worlds-dir", self.worlds,
              "__ns:=" + namespace, "_real_time_factor:=0", "_gui:=%s" % str(gui).lower()],
-            stdout=output, stderr=subprocess.STDOUT, start_new_session=True)
+            stdout=output, stderr=subprocess.STDOUT, start_new_session=True, env=env)
         try:
             deadline = time.monotonic() + 40.0
             topic = namespace + "/gazebo/model_states"
@@ -60,11 +89,18 @@ class CleanShutdownTest(unittest.TestCase):
         for run in range(RUNS_SIGTERM):
             self.run_and_signal(100 + run, signal.SIGTERM, gui=False)
 
-    @unittest.skipUnless(os.environ.get("DISPLAY"), "no display (run under Xvfb for the GUI)")
+    @unittest.skipUnless(os.environ.get("DISPLAY") or shutil.which("Xvfb"),
+                         "no display and no Xvfb (apt-get install xvfb)")
     def test_sigint_leaves_no_traceback_with_the_gui(self):
-        for run in range(3):
-            text = self.run_and_signal(200 + run, signal.SIGINT, gui=True)
-            self.assertNotIn("running headless", text, "the GUI did not open:\n" + text)
+        virtual = None if os.environ.get("DISPLAY") else VirtualDisplay()
+        env = dict(os.environ, DISPLAY=virtual.display) if virtual else None
+        try:
+            for run in range(3):
+                text = self.run_and_signal(200 + run, signal.SIGINT, gui=True, env=env)
+                self.assertNotIn("running headless", text, "the GUI did not open:\n" + text)
+        finally:
+            if virtual is not None:
+                virtual.stop()
 
 
 if __name__ == "__main__":
