@@ -8,19 +8,5 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
-ready() {   # the venv with the current requirements and the tools package, both workspaces built
-  [ -x "$ROOT/.venv/bin/python" ] \
-    && (cd / && "$ROOT/.venv/bin/python" -c "import m2wr_tools" 2>/dev/null) \
-    && [ -f "$ROOT/simulation_ws/devel/setup.bash" ] && [ -f "$ROOT/catkin_ws/devel/setup.bash" ] \
-    && [ "$(cat "$ROOT/.venv/.requirements.sha256" 2>/dev/null)" = \
-         "$(sha256sum "$ROOT/requirements.txt" | cut -d' ' -f1)" ]
-}
-if ! ready; then
-  echo "evaluate: the project is not set up yet; running scripts/setup.sh" >&2
-  bash "$ROOT/scripts/setup.sh" || { echo "evaluate: scripts/setup.sh failed (see above)" >&2; exit 1; }
-fi
-
-set +u
-source "$ROOT/scripts/env.sh"
-set -u
+source "$ROOT/scripts/ensure_ready.sh" evaluate
 exec python -m m2wr_tools.evaluate "$@"
