@@ -15,6 +15,8 @@ from matplotlib.lines import Line2D                              # noqa: E402
 from matplotlib.patches import Circle, FancyArrow, Polygon                  # noqa: E402
 import numpy as np                                               # noqa: E402
 
+from .picture import frame                                       # noqa: E402
+
 SUCCESS, FAILURE = "#2ca02c", "#d62728"
 ARROW = 0.9                  # [m] length of a start pose's arrow
 
@@ -27,22 +29,10 @@ def _obstacles(ax, outlines):
 
 
 def _frame(ax, outlines, records, margin=1.0):
-    xy = [np.asarray(o.points) for o in outlines if o.kind != "circle"]
-    xy += [np.array([[o.center[0] - o.radius, o.center[1] - o.radius],
-                     [o.center[0] + o.radius, o.center[1] + o.radius]])
-           for o in outlines if o.kind == "circle"]
-    for r in records:
-        if r.get("path"):
-            xy.append(np.asarray(r["path"])[:, 1:3])
-        xy.append(np.array([[r["x"], r["y"]]]))
-    xy = np.vstack(xy)
-    low, high = xy.min(axis=0) - margin, xy.max(axis=0) + margin
-    ax.set_xlim(low[0], high[0])
-    ax.set_ylim(low[1], high[1])
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.grid(True, linewidth=0.3, alpha=0.5)
+    """The map framed on the obstacles, every start and every path."""
+    points = [np.asarray(r["path"])[:, 1:3] for r in records if r.get("path")]
+    points.append(np.array([[r["x"], r["y"]] for r in records]).reshape(-1, 2))
+    frame(ax, outlines, points, margin)
 
 
 def trajectories(path, outlines, records, title=""):

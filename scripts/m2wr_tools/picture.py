@@ -54,6 +54,27 @@ def scale_length(span):
     return 10.0 * base
 
 
+def frame(ax, outlines, points, margin=1.0):
+    """Frames the axes on every obstacle and the given (n, 2) point arrays plus a margin [m],
+    in metres, x and y to scale, with a light grid; returns the (low, high) corners."""
+    xy = list(points)
+    for outline in outlines:
+        if outline.kind == "circle":
+            cx, cy, r = outline.center + (outline.radius,)
+            xy.append(np.array([[cx - r, cy - r], [cx + r, cy + r]]))
+        else:
+            xy.append(np.asarray(outline.points))
+    xy = np.vstack(xy) if xy else np.zeros((1, 2))
+    low, high = xy.min(axis=0) - margin, xy.max(axis=0) + margin
+    ax.set_xlim(low[0], high[0])
+    ax.set_ylim(low[1], high[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.grid(True, linewidth=0.3, alpha=0.5)
+    return low, high
+
+
 def draw(path, outlines, times, xs, ys, yaws, beams=None, collisions=(), title="",
          margin=1.0, dpi=120):
     """Writes the picture to `path`.
@@ -94,24 +115,10 @@ def draw(path, outlines, times, xs, ys, yaws, beams=None, collisions=(), title="
         c = np.asarray(collisions, dtype=float).reshape(-1, 2)
         ax.plot(c[:, 0], c[:, 1], "x", color="#ff7f0e", markersize=10, mew=2.5, zorder=5,
                 label="collision (%d)" % len(c))
-    # extent: every obstacle and the path, plus a margin
-    xy = [np.stack([xs, ys], axis=1)] if len(xs) else []
-    for outline in outlines:
-        if outline.kind == "circle":
-            cx, cy, r = outline.center + (outline.radius,)
-            xy.append(np.array([[cx - r, cy - r], [cx + r, cy + r]]))
-        else:
-            xy.append(np.asarray(outline.points))
+    points = [np.stack([xs, ys], axis=1)] if len(xs) else []
     if beams is not None and len(beams):
-        xy.append(beams[:, 1, :])
-    xy = np.vstack(xy) if xy else np.zeros((1, 2))
-    low, high = xy.min(axis=0) - margin, xy.max(axis=0) + margin
-    ax.set_xlim(low[0], high[0])
-    ax.set_ylim(low[1], high[1])
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.grid(True, linewidth=0.3, alpha=0.5)
+        points.append(beams[:, 1, :])
+    low, high = frame(ax, outlines, points, margin)
     length = scale_length(float(high[0] - low[0]))
     ax.add_artist(AnchoredSizeBar(ax.transData, length, "%g m" % length, "upper right",
                                   bbox_to_anchor=(1.0, -0.07), bbox_transform=ax.transAxes,
