@@ -103,3 +103,36 @@ def test_silent_controllers_cost_one_timeout_until_a_command_comes_again():
     lock.expect_answer(commands_before=lock.commands, needed_at=1.05)
     lock.wait_if_due(1.05, lambda: True)               # silent again: waits and says so
     assert len(timeouts) == 2
+
+
+def test_a_pause_is_not_silence():
+    """An agent pauses physics after each observation and thinks as long as it likes: the
+    wait ends without a timeout, no step is allowed, and after the pause the same answer is
+    awaited again (a timeout here made the next episode's first steps skip lockstep)."""
+    paused = [False]
+    timeouts = []
+    lock = Lockstep(True, 0.3, on_timeout=lambda: timeouts.append(True),
+                    is_shutdown=lambda: False, is_paused=lambda: paused[0])
+    lock.expect_answer(commands_before=lock.commands, needed_at=0.05)
+    threading.Timer(0.05, lambda: paused.__setitem__(0, True)).start()
+    start = time.monotonic()
+    assert lock.wait_if_due(0.05, lambda: True) is False       # the pause ended the wait
+    assert time.monotonic() - start < 0.25 and timeouts == []
+    time.sleep(0.5)                                            # longer than the timeout
+    paused[0] = False
+    threading.Timer(0.1, lock.command_arrived).start()
+    assert lock.wait_if_due(0.05, lambda: True) is True        # the same answer, awaited
+    assert lock.commands == 1 and timeouts == []
+
+
+def test_a_reset_forgets_the_silence():
+    lock, timeouts = make(timeout=0.1)
+    lock.expect_answer(commands_before=lock.commands, needed_at=0.0)
+    lock.wait_if_due(0.0, lambda: True)
+    assert len(timeouts) == 1 and lock.silent_at == lock.commands
+    lock.forget()                                              # reset_simulation
+    lock.expect_answer(commands_before=lock.commands, needed_at=0.05)
+    threading.Timer(0.05, lock.command_arrived).start()
+    start = time.monotonic()
+    lock.wait_if_due(0.05, lambda: True)                       # waited for, not skipped
+    assert lock.commands == 1 and time.monotonic() - start >= 0.04 and len(timeouts) == 1

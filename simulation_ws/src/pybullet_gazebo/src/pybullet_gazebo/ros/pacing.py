@@ -14,7 +14,10 @@ wake on /clock, not on scans: when no answer came within WAKE_AFTER of wall time
 `before_wait` is called (the node brings /clock up to now), so a loop whose tick fell since the last /clock publishes its command before the
 drive reads it. When no command comes within `timeout` (every controller switched off, say),
 lockstep reports it once and stops waiting until the next command arrives, instead of
-stalling `timeout` at every scan.
+stalling `timeout` at every scan. Time spent paused is not silence: a pause (an agent that
+thinks between steps, a user at the GUI) interrupts the wait, and the wait starts afresh, for
+the same answer, once physics runs again. A reset forgets both the awaited answer and the
+silence (a new episode: its controller is waited for again).
 """
 import threading
 import time
@@ -44,11 +47,13 @@ class RealTimePacer:
 class Lockstep:
     WAKE_AFTER = 0.005        # [s] wall: how long an answer may take before the wake-up /clock
 
-    def __init__(self, enabled, timeout, on_timeout, is_shutdown, before_wait=lambda: None):
+    def __init__(self, enabled, timeout, on_timeout, is_shutdown, before_wait=lambda: None,
+                 is_paused=lambda: False):
         self.enabled = enabled
         self.timeout = timeout               # [s] wall
         self.on_timeout = on_timeout         # called once per silence (see the docstring)
         self.is_shutdown = is_shutdown
+        self.is_paused = is_paused           # physics paused: a wait ends without a verdict
         self.before_wait = before_wait       # called before waiting for an answer not yet in
         self.commands = 0                    # commands received since the start
         self.silent_at = None                # commands counted when a wait last timed out
@@ -67,35 +72,45 @@ class Lockstep:
             self._awaited = (commands_before, needed_at)
 
     def forget(self):
+        """A reset: no answer awaited, and no controller taken as silent any more."""
         self._awaited = None
+        self.silent_at = None
 
     def wait_if_due(self, sim_time, anyone_commands):
         """Before a step at `sim_time`: waits for the awaited answer if it is needed now and
-        some controller publishes commands at all."""
+        some controller publishes commands at all. False when physics was paused meanwhile:
+        the step must not be taken now, and the answer is still awaited."""
         awaited = self._awaited
         if awaited is None or sim_time < awaited[1]:
-            return
-        self._awaited = None
+            return True
         if self.commands != awaited[0] or self.commands == self.silent_at \
                 or not anyone_commands():
-            return                  # answered already, controllers silent, or none at all
+            self._awaited = None
+            return True             # answered already, controllers silent, or none at all
         deadline = time.monotonic() + self.timeout
         # a controller that answers scans is usually a few ms away: no wake-up /clock for it
         # (each /clock wakes every node); one on its own loop gets it after WAKE_AFTER
-        if self._wait_for(awaited[0], min(deadline, time.monotonic() + self.WAKE_AFTER)):
-            return
-        self.before_wait()
-        if not self._wait_for(awaited[0], deadline):
+        outcome = self._wait_for(awaited[0], min(deadline, time.monotonic() + self.WAKE_AFTER))
+        if outcome is None:
+            self.before_wait()
+            outcome = self._wait_for(awaited[0], deadline)
+        if outcome is False:                         # paused: wait again after the pause
+            return False
+        self._awaited = None
+        if outcome is None:
             self.silent_at = self.commands
             self.on_timeout()
+        return True
 
     def _wait_for(self, commands_before, deadline):
-        """Waits until a command beyond `commands_before` came (True) or the wall clock
-        reached `deadline` (False)."""
+        """Waits until a command beyond `commands_before` came (True), physics was paused
+        (False) or the wall clock reached `deadline` (None)."""
         with self._arrived:
             while self.commands == commands_before and not self.is_shutdown():
+                if self.is_paused():
+                    return False
                 left = deadline - time.monotonic()
                 if left <= 0:
-                    return False
-                self._arrived.wait(min(left, 0.1))
+                    return None
+                self._arrived.wait(min(left, 0.02))
         return True

@@ -68,7 +68,7 @@ class SimulatorNode:
             on_timeout=lambda: rospy.loginfo(
                 "lockstep: no cmd_vel within %.2f s of a scan; stepping on without waiting "
                 "until a cmd_vel comes again" % params.lockstep_timeout),
-            before_wait=self._clock_now)
+            before_wait=self._clock_now, is_paused=lambda: self.paused)
         self._bindings = {}                       # robot name -> RobotBindings
         self._running = False                     # run() is stepping
         self._tf_publisher = None
@@ -169,7 +169,8 @@ class SimulatorNode:
             if self.paused:
                 time.sleep(0.01)
                 continue
-            self.lockstep.wait_if_due(self.world.sim_time, self._commands_heard)
+            if not self.lockstep.wait_if_due(self.world.sim_time, self._commands_heard):
+                continue                          # paused while waiting: no step now
             with self.lock:
                 readings = self.world.step()
                 commands_before = self.lockstep.commands
