@@ -31,6 +31,8 @@ from .wrenches import WrenchSchedule
 
 __all__ = ["World", "SpawnError", "ModelNotFound", "Robot", "Entity", "Reading"]
 
+PARKING_HEIGHT = 1000.0      # [m] above its pose, where a teleported body sheds its contacts
+
 
 class ModelNotFound(KeyError):
     def __str__(self):
@@ -175,6 +177,8 @@ class World:
         pose = checked_pose(pose, "model state of '%s'" % name, "nothing changed",
                             linear=linear, angular=angular, zero_is_identity=True)
         self.layout_version += 1
+        if not entity.static:
+            self._drop_cached_contacts(entity)
         for index, body in enumerate(entity.body_ids):
             self._place(entity, index, pose.compose(entity.link_offsets[index]))
             self.client.resetBaseVelocity(body, list(linear), list(angular))
@@ -346,6 +350,19 @@ class World:
         position, orientation = self.client.getBasePositionAndOrientation(entity.body_ids[index])
         inertial = Pose(tuple(position), tuple(orientation))
         return inertial.compose(entity.inertial_offsets[index].inverse())
+
+    def _drop_cached_contacts(self, entity):
+        """Bullet keeps a body's contact points from step to step (warm-start impulses, the
+        friction anchors of a standing robot). A teleported body must not carry them to its
+        new pose: they would act on its first steps there, and a run after a reset would not
+        repeat a fresh start. Parking the body far above everything and running collision
+        detection makes Bullet drop them itself (each point is now beyond its breaking
+        distance), without rebuilding anything, so the solver's order stays as it was."""
+        for index, body in enumerate(entity.body_ids):
+            position, orientation = self.client.getBasePositionAndOrientation(body)
+            self.client.resetBasePositionAndOrientation(
+                body, (position[0], position[1], position[2] + PARKING_HEIGHT), orientation)
+        self.client.performCollisionDetection()
 
     def _place(self, entity, index, link_pose: Pose):
         inertial = link_pose.compose(entity.inertial_offsets[index])

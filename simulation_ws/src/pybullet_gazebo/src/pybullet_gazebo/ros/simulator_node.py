@@ -172,6 +172,8 @@ class SimulatorNode:
             if not self.lockstep.wait_if_due(self.world.sim_time, self._commands_heard):
                 continue                          # paused while waiting: no step now
             with self.lock:
+                if self.paused:                   # paused (or reset) while we waited
+                    continue
                 readings = self.world.step()
                 commands_before = self.lockstep.commands
                 now = self.world.sim_time
