@@ -19,6 +19,7 @@ import rospy
 import rostest
 
 from m2wr_gym.env import M2wrEnv
+from m2wr_gym.sim_ros import RosSimError
 
 KWARGS = dict(world="world02", start=[(0.0, 8.0, 0.0)], action="continuous", laser_noise=0.0)
 ACTIONS = ([(0.5, 0.0)] * 15 + [(0.3, 0.6)] * 15 + [(0.0, -0.8)] * 15 + [(0.5, 0.0)] * 15)
@@ -74,6 +75,14 @@ class RosMatchesInProcess(unittest.TestCase):
 
     def test_ros_runs_repeat(self):
         self.check_close(self.ros, self.ros_again, "ROS run 1 vs 2")
+
+    def test_a_turning_the_simulator_does_not_run_is_refused(self):
+        """The simulator runs Noetic's drive (legacy_mode:=false): an environment that means
+        Kinetic's turning would steer the wrong way, so it is refused, saying what to do."""
+        with self.assertRaises(RosSimError) as caught:
+            M2wrEnv(backend="ros", turning="legacy", **KWARGS)
+        self.assertIn("legacy_mode:=false", str(caught.exception))
+        self.assertIn("turning='gazebo'", str(caught.exception))
 
 
 if __name__ == "__main__":

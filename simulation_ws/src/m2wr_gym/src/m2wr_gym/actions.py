@@ -79,13 +79,5 @@ def to_command(kind, action, turning):
     return float(v), float(w)
 
 
-def drive_command(command, turning):
-    """What the in-process drive must be told for `command` to do what the chosen turning
-    does: Gazebo's drive as it is, or Kinetic's legacy mode (the wheels' formulas swapped,
-    which for a command (v, w) is Gazebo's drive given (v, -w))."""
-    v, w = command
-    return (v, w) if turning == "gazebo" else (v, -w)
-
-
 def is_finite(command):
     return all(math.isfinite(c) for c in command)

@@ -63,14 +63,16 @@ class M2wrEnv(gymnasium.Env):
         o = self.options
         if o.backend == "ros":
             from .sim_ros import RosSim              # rospy only when asked for
-            return RosSim(self.world_path, o.physics_step, o.laser_noise)
+            return RosSim(self.world_path, o.physics_step, o.laser_noise,
+                          legacy_mode=o.turning == "legacy")
         from .sim_inprocess import InProcessSim
         gui = self.render_mode == "human"
         if gui and not os.environ.get("DISPLAY"):
             LOG.warning("m2wr_gym: render_mode='human' but there is no display (DISPLAY is "
                         "unset): running without pybullet's window")
             gui = False
-        return InProcessSim(self.world_path, o.physics_step, o.laser_noise, gui=gui)
+        return InProcessSim(self.world_path, o.physics_step, o.laser_noise, gui=gui,
+                            legacy_mode=o.turning == "legacy")
 
     def _draw_start_pool(self):
         start = self.options.start
@@ -145,8 +147,7 @@ class M2wrEnv(gymnasium.Env):
             info["invalid_action"] = str(err)
             return self._observe(), 0.0, False, True, info
         before = self._snapshot
-        after = self.sim.run(*actions.drive_command(command, self.options.turning),
-                             steps=self.options.steps_per_action)
+        after = self.sim.run(*command, steps=self.options.steps_per_action)
         self._snapshot = after
         self._steps += 1
         self._distance += math.hypot(after.x - before.x, after.y - before.y)

@@ -47,9 +47,11 @@ def robot_urdf(laser_noise=None):
 
 
 class InProcessSim:
-    def __init__(self, world_path, physics_step=0.005, laser_noise=None, gui=False):
+    def __init__(self, world_path, physics_step=0.005, laser_noise=None, gui=False,
+                 legacy_mode=False):
         self.spec = resources.world_spec(world_path)
         self.physics_step = physics_step          # [s]
+        self.legacy_mode = legacy_mode            # the simulator's legacy_mode:=true
         self.urdf = robot_urdf(laser_noise)
         self.warnings = []
         self.client = BulletClient(connection_mode=pybullet.GUI if gui else pybullet.DIRECT)
@@ -63,7 +65,7 @@ class InProcessSim:
         """A fresh world with m2wr at (x, y, yaw) at rest; ValueError naming the pose when it
         is inside an obstacle. Returns the first scan (taken at sim time 0)."""
         self.world = World(self.client, self.spec, self.physics_step, seed=seed,
-                           warn=self.warnings.append)
+                           warn=self.warnings.append, legacy_mode=self.legacy_mode)
         pose = Pose.from_xyz_rpy(x, y, REST_Z, 0.0, 0.0, yaw)
         try:
             robot = self.world.spawn_urdf(ROBOT, self.urdf, pose)

@@ -16,7 +16,9 @@ Reset: pause, /gazebo/reset_simulation (sim time 0), /gazebo/set_model_state to 
 pose, unpause, take the first scan (stamped one physics step), pause.
 The pose is /odom's (the drive's odometrySource world: the true pose) stamped with the scan's
 sim time (after a reset both are first due at the first physics step, then every 0.05 s);
-contacts come from /gazebo/contacts. The laser noise follows the simulator's own `seed`, not reset(seed=...).
+contacts come from /gazebo/contacts. The environment's turning must be the simulator's
+(legacy_mode:=true for turning="legacy"), else RosSimError says which to change.
+The laser noise follows the simulator's own `seed`, not reset(seed=...).
 """
 import math
 import queue
@@ -38,7 +40,8 @@ class RosSimError(RuntimeError):
 
 
 class RosSim:
-    def __init__(self, world_path, physics_step=0.005, laser_noise=None, timeout=30.0):
+    def __init__(self, world_path, physics_step=0.005, laser_noise=None, timeout=30.0,
+                 legacy_mode=False):
         import rospy
         from geometry_msgs.msg import Twist
         from gazebo_msgs.msg import ContactsState
@@ -64,6 +67,15 @@ class RosSim:
         if not rospy.get_param("/gazebo/lockstep", False):
             raise RosSimError("the simulator runs without lockstep, so steps would not be exact;"
                               " start it with lockstep:=true")
+        running = bool(rospy.get_param("/gazebo/legacy_mode", False))
+        if running != bool(legacy_mode):
+            raise RosSimError(
+                "the simulator runs with legacy_mode:=%s but the environment's turning is %r: "
+                "a positive angular.z would turn m2wr the other way than the environment "
+                "means; start the simulator with legacy_mode:=%s or make the environment with "
+                "turning=%r" % (str(running).lower(), "legacy" if legacy_mode else "gazebo",
+                                str(bool(legacy_mode)).lower(),
+                                "legacy" if running else "gazebo"))
         call = lambda name, kind: rospy.ServiceProxy("/gazebo/" + name, kind, persistent=True)
         self._pause, self._unpause = call("pause_physics", Empty), call("unpause_physics", Empty)
         self._reset_sim = call("reset_simulation", Empty)
