@@ -179,8 +179,12 @@ def main(argv=None):
             self.next_report = args.report_every
 
         def _on_step(self):
-            if self.num_timesteps >= self.next_report or self.num_timesteps >= args.timesteps:
-                self.next_report += args.report_every
+            # SB3 finishes its last rollout past `timesteps`: one line for the end, not one
+            # per step of that rollout
+            if self.num_timesteps >= self.next_report or (
+                    self.num_timesteps >= args.timesteps and self.next_report < math.inf):
+                self.next_report = math.inf if self.num_timesteps >= args.timesteps \
+                    else self.next_report + args.report_every
                 elapsed = time.monotonic() - self.started
                 rate = self.num_timesteps / max(elapsed, 1e-9)
                 _, returns = read_monitor(monitors)
@@ -189,7 +193,8 @@ def main(argv=None):
                       "%5.0f steps/s  %5.0f s elapsed, ~%4.0f s left"
                       % (self.num_timesteps, args.timesteps, len(returns), len(recent),
                          recent.mean() if len(recent) else math.nan, rate, elapsed,
-                         (args.timesteps - self.num_timesteps) / max(rate, 1e-9)), flush=True)
+                         max(args.timesteps - self.num_timesteps, 0) / max(rate, 1e-9)),
+                      flush=True)
             return True
 
     started = time.monotonic()
