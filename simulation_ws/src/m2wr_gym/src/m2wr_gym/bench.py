@@ -8,7 +8,9 @@
 2. Two environments in subprocesses (gymnasium's AsyncVectorEnv) against one, in env steps
    per second of wall time.
 Measurements alternate in rounds (--rounds) and the best round of each is kept, so a busy
-moment of a shared machine hits both sides alike.
+moment of a shared machine hits both sides alike. The in-process figures are also given per
+second of this process's CPU time, which other programs on a shared machine disturb far less
+than wall time.
 """
 import argparse
 import time
@@ -35,27 +37,27 @@ def bare_bullet(seconds):
     sim._drive.set_command(0.3, 0.2)
     sim.world.step()                      # the drive applies the command once
     client, steps = sim.client, int(seconds / sim.physics_step)
-    started = time.perf_counter()
+    started, cpu_started = time.perf_counter(), time.process_time()
     for _ in range(steps):
         client.stepSimulation()
-    wall = time.perf_counter() - started
+    wall, cpu = time.perf_counter() - started, time.process_time() - cpu_started
     env.close()
-    return steps * sim.physics_step / wall
+    return steps * sim.physics_step / wall, steps * sim.physics_step / cpu
 
 
 def one_env(steps, seed=0):
     env = make()
     env.action_space.seed(seed)
     env.reset(seed=seed)
-    started = time.perf_counter()
+    started, cpu_started = time.perf_counter(), time.process_time()
     for _ in range(steps):
         _, _, terminated, truncated, _ = env.step(env.action_space.sample())
         if terminated or truncated:
             env.reset()
-    wall = time.perf_counter() - started
+    wall, cpu = time.perf_counter() - started, time.process_time() - cpu_started
     dt = env.unwrapped.dt
     env.close()
-    return steps * dt / wall, steps / wall
+    return steps * dt / wall, steps / wall, steps * dt / cpu
 
 
 def vector_env(n, steps):
@@ -79,11 +81,15 @@ def main(argv=None):
     p.add_argument("--steps", type=int, default=600, help="env steps per measurement")
     args = p.parse_args(argv)
     bare, env_rate, env_steps, one_sub, two_sub = [], [], [], [], []
+    bare_cpu, env_cpu = [], []
     for r in range(args.rounds):
-        bare.append(bare_bullet(args.steps * 0.1))
-        rate, per_s = one_env(args.steps, seed=r)
+        rate, cpu_rate = bare_bullet(args.steps * 0.1)
+        bare.append(rate)
+        bare_cpu.append(cpu_rate)
+        rate, per_s, cpu_rate = one_env(args.steps, seed=r)
         env_rate.append(rate)
         env_steps.append(per_s)
+        env_cpu.append(cpu_rate)
         one_sub.append(vector_env(1, args.steps))
         two_sub.append(vector_env(2, args.steps))
         print("[bench] round %d/%d: bare Bullet %.0fx real time, env %.0fx (%.0f steps/s), "
@@ -96,6 +102,8 @@ def main(argv=None):
     print("  one environment in process:              %6.0f sim s / wall s  (%.0f env steps/s)"
           % (max(env_rate), max(env_steps)))
     print("  environment / bare Bullet:               %6.2f" % (max(env_rate) / max(bare)))
+    print("  per CPU second: bare Bullet %.0f, environment %.0f sim s; ratio %.2f"
+          % (max(bare_cpu), max(env_cpu), max(env_cpu) / max(bare_cpu)))
     print("  one environment in a subprocess:         %6.0f env steps/s" % max(one_sub))
     print("  two environments in subprocesses:        %6.0f env steps/s  (%.2fx one in a "
           "subprocess, %.2fx one in process)" % (max(two_sub), max(two_sub) / max(one_sub),

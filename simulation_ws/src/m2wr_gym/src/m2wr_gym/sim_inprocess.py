@@ -88,15 +88,17 @@ class InProcessSim:
         """Sets the drive's command and steps physics `steps` times; the command reaches the
         wheels at the drive's next update (20 Hz for m2wr), as a cmd_vel would. Only the
         laser's last scan of these steps is observed, so only that one is cast: the scans
-        before it are skipped (their schedule and noise draws go on as if cast)."""
+        before it and the other parts' readings are skipped (their schedules and noise draws
+        go on as if made)."""
         self._drive.set_command(linear_x, angular_z)
         world = self.world
         scans = self._laser.scans_at([world.time_after(k) for k in range(1, steps + 1)])
         observed = scans[-1] if scans else -1          # index of the step that casts it
+        laser, nothing = (self._laser,), ()
         touched = set()
         readings = []
         for k in range(steps):
-            readings.extend(world.step(collect=k == observed))
+            readings.extend(world.step(collect=laser if k == observed else nothing))
             for _, other in world.touching():
                 touched.add(other)
         return self._snapshot(readings, tuple(sorted(touched)))

@@ -197,9 +197,10 @@ class _Group:
         if not self.bodies:
             return None, [], None
         positions, orientations = [], []
+        base_pose = client.getBasePositionAndOrientation     # bound once for all bodies
         for body in self.bodies:
             if body.links[0] == -1:
-                pos, orn = client.getBasePositionAndOrientation(body.body_id)
+                pos, orn = base_pose(body.body_id)
                 positions.append(pos)
                 orientations.append(orn)
             if body.links[-1] >= 0:

@@ -123,10 +123,11 @@ class World:
         then read, to the last bit)."""
         return self._time_before + (self.step_count + steps - self._steps_before) * self.step_size
 
-    def step(self, collect: bool = True) -> List[Reading]:
-        """Advances physics by one fixed step; returns the parts' readings now due. With
-        collect=False no reading is made ([] is returned): the parts due now skip theirs
-        (Part.skip), their schedules and noise going on as if they had measured."""
+    def step(self, collect=True) -> List[Reading]:
+        """Advances physics by one fixed step; returns the parts' readings now due. `collect`:
+        True = every part's, or a collection of the parts whose readings are wanted (empty:
+        none); the other parts due now skip theirs (Part.skip), their schedules and noise
+        going on as if they had measured."""
         if self._robots is None:
             self.robots()                   # refreshes the caches after a spawn or delete
         now = self.sim_time
@@ -141,7 +142,7 @@ class World:
         for robot, part in parts:
             part.after_step(now)
             if part.due(now):
-                if collect:
+                if collect is True or part in collect:
                     readings.append(Reading(robot, part, part.measure(now)))
                 else:
                     part.skip(now)
