@@ -176,8 +176,9 @@ def main(argv=None):
           "subprocess, %.2fx one in process)" % (max(two_sub), max(two_sub) / max(one_sub),
                                                  max(two_sub) / max(env_steps)))
     parts = min(parts_by_round, key=lambda parts: parts["env step"])
-    print("  CPU per env step in process [us] (round with the least): %.0f = Bullet's physics %.0f + engine around it "
-          "%.0f + one scan %.0f + environment %.0f; physics alone allows a ratio of at most %.2f"
+    print("  CPU per env step in process [us] (round with the least): %.0f = Bullet's physics "
+          "%.0f + engine around it %.0f + one scan %.0f + environment %.0f; physics alone "
+          "allows a ratio of at most %.2f"
           % (parts["env step"], parts["physics"], parts["engine"], parts["scan"], parts["env"],
              parts["physics"] / parts["env step"]))
     print("  the machine's ceiling: two bare Bullet processes at once %.2fx one"
