@@ -36,9 +36,10 @@ class ContactTracker:
                 if owner is None or owner == name or owner in grounds:
                     continue
                 touching.add((name, owner))
-        for pair in sorted(touching - self._touching):
-            self.events.append(ContactEvent(sim_time, *pair))
-            self.event_count += 1
+        if touching:                             # (the usual case, no touch, costs nothing)
+            for pair in sorted(touching - self._touching):
+                self.events.append(ContactEvent(sim_time, *pair))
+                self.event_count += 1
         self._touching = touching
 
     def touching(self) -> List[Tuple[str, str]]:
