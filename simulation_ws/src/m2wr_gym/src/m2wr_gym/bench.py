@@ -8,10 +8,12 @@
 2. Two environments in subprocesses (gymnasium's AsyncVectorEnv) against one, in env steps
    per second of wall time; and, as the machine's own ceiling for that ratio, two bare
    Bullet steppers in two processes at once against one.
+3. Where one in-process control step's CPU time goes (see breakdown()): Bullet's physics,
+   the engine's work around it, the one scan observed, the environment's own Python.
 Measurements alternate in rounds (--rounds) and the best round of each is kept, so a busy
 moment of a shared machine hits both sides alike. The in-process figures are also given per
-second of this process's CPU time, which other programs on a shared machine disturb far less
-than wall time.
+second of this process's CPU time, which other programs on a shared machine disturb less
+than wall time (but still: note the load, `uptime`, with any figure).
 """
 import argparse
 import multiprocessing
@@ -177,8 +179,8 @@ def main(argv=None):
                                                  max(two_sub) / max(env_steps)))
     parts = min(parts_by_round, key=lambda parts: parts["env step"])
     print("  CPU per env step in process [us] (round with the least): %.0f = Bullet's physics "
-          "%.0f + engine around it %.0f + one scan %.0f + environment %.0f; physics alone "
-          "allows a ratio of at most %.2f"
+          "%.0f + engine around it %.0f + one scan %.0f + environment %.0f; "
+          "env / bare Bullet from these: %.2f"
           % (parts["env step"], parts["physics"], parts["engine"], parts["scan"], parts["env"],
              parts["physics"] / parts["env step"]))
     print("  the machine's ceiling: two bare Bullet processes at once %.2fx one"
