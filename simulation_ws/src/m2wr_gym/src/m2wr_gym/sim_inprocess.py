@@ -59,6 +59,7 @@ class InProcessSim:
             self.client.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0)
         self.world = None
         self._drive = None
+        self._laser = None
         self._laser_last = None
 
     def reset(self, x, y, yaw, seed):
@@ -78,19 +79,27 @@ class InProcessSim:
             raise RuntimeError("m2wr should have one drive and one laser; it has %d and %d"
                                % (len(drives), len(lasers)))
         self._drive = drives[0]
+        self._laser = lasers[0]
         self._laser_last = None
         readings = self.world.step()           # the laser's first scan is due at once
         return self._snapshot(readings, ())
 
     def run(self, linear_x, angular_z, steps):
         """Sets the drive's command and steps physics `steps` times; the command reaches the
-        wheels at the drive's next update (20 Hz for m2wr), as a cmd_vel would."""
+        wheels at the drive's next update (20 Hz for m2wr), as a cmd_vel would. Only the
+        laser's last scan of these steps is observed, so only that one is cast: the scans
+        before it and the other parts' readings are skipped (their schedules and noise draws
+        go on as if made)."""
         self._drive.set_command(linear_x, angular_z)
+        world = self.world
+        scans = self._laser.scans_at([world.time_after(k) for k in range(1, steps + 1)])
+        observed = scans[-1] if scans else -1          # index of the step that casts it
+        laser, nothing = (self._laser,), ()
         touched = set()
         readings = []
-        for _ in range(steps):
-            readings.extend(self.world.step())
-            for _, other in self.world.touching():
+        for k in range(steps):
+            readings.extend(world.step(collect=laser if k == observed else nothing))
+            for _, other in world.touching():
                 touched.add(other)
         return self._snapshot(readings, tuple(sorted(touched)))
 

@@ -21,21 +21,25 @@ class ContactTracker:
         self.events = deque(maxlen=max_events)   # the most recent touch onsets
         self.event_count = 0                     # every onset since the start
         self._touching = set()                   # (robot, other) pairs touching now
+        self._client = self._contact_points = None
 
     def update(self, client, sim_time, robots: Iterable[Tuple[str, int]],
                owner_of: Dict[int, str], grounds: AbstractSet[str]):
         """Reads Bullet's contact points of each (robot name, body) after a step; touches of
         the models named in `grounds` are not counted."""
+        if client is not self._client:       # bound once: called after every physics step
+            self._client, self._contact_points = client, client.getContactPoints
         touching = set()
         for name, body in robots:
-            for point in client.getContactPoints(bodyA=body):
+            for point in self._contact_points(bodyA=body):
                 owner = owner_of.get(point[2])
                 if owner is None or owner == name or owner in grounds:
                     continue
                 touching.add((name, owner))
-        for pair in sorted(touching - self._touching):
-            self.events.append(ContactEvent(sim_time, *pair))
-            self.event_count += 1
+        if touching:                             # (the usual case, no touch, costs nothing)
+            for pair in sorted(touching - self._touching):
+                self.events.append(ContactEvent(sim_time, *pair))
+                self.event_count += 1
         self._touching = touching
 
     def touching(self) -> List[Tuple[str, str]]:

@@ -8,6 +8,9 @@ so the World calls them all and never probes a part for what it can do. Per phys
     after_step(now)        the step ended; `now` is the new sim time [s]
     due(now) -> bool       a reading is due now; if so the World calls measure(now) at once
     measure(now)           the reading (LaserScanData, Odometry, JointStates, ...): plain data
+    skip(now)              instead of measure(now) when nobody reads it (World.step with
+                           collect=False): the part's schedule and noise stream advance
+                           exactly as if it had measured (default: measure, result dropped)
 
 and on demand:
 
@@ -69,6 +72,9 @@ class Part:
 
     def measure(self, now: float):
         return None
+
+    def skip(self, now: float) -> None:
+        self.measure(now)
 
     def reset(self) -> None:
         pass

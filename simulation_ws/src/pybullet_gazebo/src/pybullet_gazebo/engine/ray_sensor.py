@@ -26,6 +26,14 @@ from .transforms import Pose
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
 
 
+def _due(last, sim_time, period):
+    """A scan is due at sim_time [s] when `period` [s] passed since the last one (sim time
+    `last`, None before the first), and when the sim time went backwards."""
+    if last is None or sim_time < last:
+        return True
+    return sim_time - last >= period - _TOLERANCE
+
+
 @dataclass
 class LaserScanData:
     """What a sensor_msgs/LaserScan carries, without ROS."""
@@ -103,9 +111,25 @@ class RaySensor(Part):
     def due(self, sim_time):
         """True when at least 1/update_rate [s] of sim time passed since the last scan (and on
         the first call, and when the sim time went backwards)."""
-        if self._last is None or sim_time < self._last:
-            return True
-        return sim_time - self._last >= self._period - _TOLERANCE
+        return _due(self._last, sim_time, self._period)
+
+    def scans_at(self, times):
+        """Indices of the coming sim times `times` [s] (ascending) at which the sensor will
+        scan, if it is asked at each of them and nothing resets it in between."""
+        last, indices = self._last, []
+        for index, sim_time in enumerate(times):
+            if _due(last, sim_time, self._period):
+                last = sim_time
+                indices.append(index)
+        return indices
+
+    def skip(self, sim_time):
+        """A scan due at `sim_time` [s] that nobody reads: nothing is cast, but the schedule
+        and the noise stream advance exactly as measure() would advance them."""
+        spec = self.spec
+        if spec.noise_stddev > 0.0 or spec.noise_mean != 0.0:
+            self.rng.normal(spec.noise_mean, spec.noise_stddev, len(self._beams))
+        self._last = sim_time
 
     def sensor_pose(self):
         """World pose of the sensor frame: the link frame composed with the sensor's pose."""
@@ -130,7 +154,8 @@ class RaySensor(Part):
             # one draw per beam whether it hit or not, so the stream does not depend on the scene
             noise = self.rng.normal(spec.noise_mean, spec.noise_stddev, len(ranges))
             hit = np.isfinite(ranges)
-            ranges[hit] = np.clip(ranges[hit] + noise[hit], spec.range_min, spec.range_max)
+            ranges[hit] = np.minimum(np.maximum(ranges[hit] + noise[hit], spec.range_min),
+                                     spec.range_max)             # np.clip, without its overhead
         self._last = sim_time
         return LaserScanData(
             stamp=sim_time, frame_id=self.frame_id,

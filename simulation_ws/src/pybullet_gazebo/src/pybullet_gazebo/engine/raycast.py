@@ -197,9 +197,10 @@ class _Group:
         if not self.bodies:
             return None, [], None
         positions, orientations = [], []
+        base_pose = client.getBasePositionAndOrientation     # bound once for all bodies
         for body in self.bodies:
             if body.links[0] == -1:
-                pos, orn = client.getBasePositionAndOrientation(body.body_id)
+                pos, orn = base_pose(body.body_id)
                 positions.append(pos)
                 orientations.append(orn)
             if body.links[-1] >= 0:
@@ -343,7 +344,7 @@ class RayCaster:
         origin = np.asarray(origin, dtype=float).reshape(3)
         directions = np.asarray(directions, dtype=float).reshape(-1, 3)
         norms = np.sqrt((directions * directions) @ _ONES)
-        if not (np.all(norms > 0.0) and np.all(np.isfinite(norms))):
+        if not ((norms > 0.0).all() and np.isfinite(norms).all()):
             raise ValueError("RayCaster.cast: every direction must be a finite non-zero vector")
         directions = directions / norms[:, None]
         range_min = max(0.0, float(range_min))
@@ -401,13 +402,13 @@ class RayCaster:
         if len(directions) < 2:
             return None
         first = directions[0]
-        other = directions[np.argmin(np.abs(directions @ first))]
+        other = directions[np.abs(directions @ first).argmin()]
         normal = np.array(cross(first, other))
         length = np.sqrt(normal @ normal)
         if length < 1e-6:                          # all (anti)parallel: no single plane
             return None
         normal /= length
-        if np.max(np.abs(directions @ normal)) > 1e-9:
+        if np.abs(directions @ normal).max() > 1e-9:
             return None
         return normal
 

@@ -67,6 +67,7 @@ class World:
         self._stepped = ([], [])                    # cache: (robot, part) pairs, (name, body)
         self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
+        self._step_simulation = client.stepSimulation   # bound once: called 200 times a second
         self.gravity = tuple(spec.physics.gravity)   # [m/s^2]
         self.wrenches = WrenchSchedule(client, self.gravity)   # apply_body_wrench & co.
         self.layout_version = 0     # counts teleports and deletions (caches of static poses)
@@ -117,22 +118,34 @@ class World:
                     self.client.changeDynamics(
                         body, -1, activationState=pybullet.ACTIVATION_STATE_WAKE_UP)
 
-    def step(self) -> List[Reading]:
-        """Advances physics by one fixed step; returns the parts' readings now due."""
+    def time_after(self, steps: int) -> float:
+        """Sim time [s] after `steps` more physics steps of the present size (as sim_time will
+        then read, to the last bit)."""
+        return self._time_before + (self.step_count + steps - self._steps_before) * self.step_size
+
+    def step(self, collect=True) -> List[Reading]:
+        """Advances physics by one fixed step; returns the parts' readings now due. `collect`:
+        True = every part's, or a collection of the parts whose readings are wanted (empty:
+        none); the other parts due now skip theirs (Part.skip), their schedules and noise
+        going on as if they had measured."""
+        if self._robots is None:
+            self.robots()                   # refreshes the caches after a spawn or delete
         now = self.sim_time
-        self.robots()                       # refreshes the caches after a spawn or delete
         parts, bodies = self._stepped
         for _, part in parts:
             part.before_step(now, self.step_size)
         self.wrenches.apply(now)
-        self.client.stepSimulation()
+        self._step_simulation()
         self.step_count += 1
         now = self.sim_time
         readings = []
         for robot, part in parts:
             part.after_step(now)
             if part.due(now):
-                readings.append(Reading(robot, part, part.measure(now)))
+                if collect is True or part in collect:
+                    readings.append(Reading(robot, part, part.measure(now)))
+                else:
+                    part.skip(now)
         self.contacts.update(self.client, now, bodies, self._body_owner, self._grounds)
         return readings
 
