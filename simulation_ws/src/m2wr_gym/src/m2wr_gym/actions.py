@@ -17,7 +17,7 @@ from gymnasium import spaces
 KINDS = ("continuous", "discrete")
 MAX_LINEAR = 0.6            # [m/s] the tutorial's forward speed
 MAX_ANGULAR = 1.0           # [rad/s]
-FORWARD = (0.5, 0.0)        # [m/s], [rad/s] (turning left is +angular in REP 103)
+FORWARD = (MAX_LINEAR, 0.0)  # [m/s], [rad/s]: the tutorial's 0.6 m/s (left is +angular in REP 103)
 TURN = (0.1, 0.8)           # slow forward while turning, as openai_ros's turtlebot does
 NAMES = ("forward", "left", "right")
 TURNINGS = ("gazebo", "legacy")
