@@ -58,13 +58,18 @@ class RunWatch:
         self.lock = threading.Lock()
         self.lines = []                    # (wall [s], sim [s], text) of BUG_NODE
         self.contact_events = []           # (sim [s], robot, model)
+        self.lockstep_timeouts = []        # wall [s] each `no cmd_vel within` was heard
         self._touching = set()
         self._subs = [rospy.Subscriber("/rosout", Log, self._on_log, queue_size=1000),
                       rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self._on_contacts,
                                        queue_size=1000)]
 
     def _on_log(self, msg):
-        if msg.name == BUG_NODE:
+        if LOCKSTEP_TIMEOUT in msg.msg:
+            with self.lock:                # the simulator logs in wall time: note when heard
+                self.lockstep_timeouts.append(time.monotonic())
+            say("  simulator: %s" % msg.msg)
+        elif msg.name == BUG_NODE:
             with self.lock:
                 self.lines.append((time.monotonic(), msg.header.stamp.to_sec(), msg.msg))
             say("  %7.2f s sim  %s" % (msg.header.stamp.to_sec(), msg.msg))
@@ -138,12 +143,25 @@ def run_world(session, world, sim_limit, wall_limit):
     watch.close()
     world_log = session.children["world"].log_path
     session.stop(["controller", "spawn", "world"])
+    run_summary = None
     with open(world_log, errors="replace") as log:
-        timeouts = sum(1 for line in log if LOCKSTEP_TIMEOUT in line)
+        timeouts = 0
+        for line in log:
+            timeouts += LOCKSTEP_TIMEOUT in line
+            if "run summary:" in line:
+                run_summary = line.split("run summary:", 1)[1].strip()
+    say("  simulator's run summary (start to stop): %s" % run_summary)
+    for name in ("world", "spawn", "controller"):      # keep each world's logs
+        path = os.path.join(session.log_dir, name + ".log")
+        if os.path.exists(path):
+            os.replace(path, os.path.join(session.log_dir, "%s_%s.log" % (world, name)))
+    during = [t for t in watch.lockstep_timeouts if placed[0] <= t <= end[0]]
     wall = end[0] - placed[0]
     figures = {"world": world, "goal": goal, "legacy_mode": legacy_mode,
                "reached": reached is not None, "wall_s": wall,
-               "lockstep_timeouts": timeouts,
+               "lockstep_timeouts": timeouts,            # in the simulator's whole log
+               "lockstep_timeouts_during_run": len(during),
+               "simulator_run_summary": run_summary,
                "contact_events": len([e for e in watch.contact_events if e[0] >= placed[1]]),
                "contacts": [list(e) for e in watch.contact_events][:10],
                "load_before": load_before[0], "load_after": os.getloadavg()[0]}
@@ -162,7 +180,7 @@ def run_world(session, world, sim_limit, wall_limit):
 def report(runs, load):
     lines = ["", "bug 2 from (0, 8), lockstep, real_time_factor 0 (load average %s)" % load,
              "%-9s %-8s %9s %9s %12s %9s %9s %14s" % ("world", "reached", "sim [s]", "wall [s]",
-                                                      "x real time", "timeouts", "contacts",
+                                                      "x real time", "timeouts*", "contacts",
                                                       "CPU sim/ctl ms per sim s")]
     for f in runs:
         cpu = f.get("cpu_ms_per_sim_s")
@@ -170,8 +188,11 @@ def report(runs, load):
             f["world"], "yes" if f["reached"] else "NO",
             "%.1f" % f["sim_s"] if "sim_s" in f else "-", f["wall_s"],
             "%.1f" % f["x_real_time"] if f.get("x_real_time") else "-",
-            f["lockstep_timeouts"], f["contact_events"],
+            f["lockstep_timeouts_during_run"], f["contact_events"],
             "%.0f / %.0f" % (cpu["simulator"], cpu["controllers"]) if cpu else "-"))
+    lines.append("* lockstep time-outs (`%s`) between placement and goal; the simulator's "
+                 "whole log: %s" % (LOCKSTEP_TIMEOUT, ", ".join(
+                     "%s %d" % (f["world"], f["lockstep_timeouts"]) for f in runs)))
     return "\n".join(lines)
 
 
