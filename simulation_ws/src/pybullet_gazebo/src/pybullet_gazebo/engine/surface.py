@@ -14,9 +14,9 @@ two rules and turns them into ERP and CFM by the same formulas, so a kp and kd t
 or URDF gives go to Bullet as they are. Gazebo's defaults do not: kp 1e12 makes ERP 1, a
 contact whose whole penetration is undone in one step, and Gazebo tames that with a limit
 Bullet lacks (each body's correcting velocity, SDF's <max_vel> 0.01 m/s); through Bullet, m2wr
-spawned with its wheels 0.1 m in the ground left it at 20 m/s. A body with default values
-keeps Bullet's own rigid contact (ERP 0.2, split impulse) instead, which is Gazebo's default
-in effect: stiff, with a gentle correction. (A pair of one body with given values and one
+spawned with its wheels 0.1 m in the ground was thrown 11 m up. A body with default values
+keeps Bullet's own rigid contact (its default ERP) instead, which is Gazebo's default in
+effect: stiff, with a gentle correction. (A pair of one body with given values and one
 with defaults then gets kd + 0.1 where Gazebo has kd + 1: Bullet's default damping.) Friction it combines differently: the PRODUCT of the two bodies'
 coefficients, clamped to 10. Products cannot equal minima for every pair, so:
 - every body gets `bullet_friction(mu)` = min(mu, 1). The product of two such coefficients is
