@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Benchmark of the stand-in (see m2wr_tools.bench, scripts/m2wr_tools/bench.py, or --help):
 #   scripts/bench.sh [--seconds 15] [--soak MINUTES] [--clock-hz 20] [--output output/]
+#   scripts/bench.sh --bug [--worlds world02 world03] [--output output/]
+#     the series' bug-2 runs in lockstep (m2wr_tools.bench_bug): x real time, lockstep
+#     time-outs, contact events
 # Prints the figures side by side and writes them to output/bench.json. Needs the project
 # set up (scripts/setup.sh); sources scripts/env.sh itself.
 set -euo pipefail
@@ -13,4 +16,8 @@ fi
 set +u
 source "$ROOT/scripts/env.sh"
 set -u
+if [ "${1:-}" = "--bug" ]; then
+  shift
+  exec python -m m2wr_tools.bench_bug "$@"
+fi
 exec python -m m2wr_tools.bench "$@"

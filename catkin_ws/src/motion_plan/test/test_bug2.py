@@ -71,12 +71,13 @@ class Bug2Test(unittest.TestCase):
         path = sum(math.hypot(b[1] - a[1], b[2] - a[2]) for a, b in zip(poses, poses[1:]))
         states = [text for t, text in self.log.since(self.start) if text.startswith("state:")]
         touches = [t for t in self.contacts.touches if self.start <= t[0] <= self.end]
+        events = self.contacts.contact_events(self.start, self.end)
         summary = ("goal (%.1f, %.1f): nearest %.3f m, %s, path %.1f m, %d state changes, "
-                   "%d touch event(s) %s" % (
+                   "%d contact event(s) %s" % (
                        self.goal[0], self.goal[1], nearest,
                        "reached after %.1f s of sim time" % (self.reached - self.start)
                        if self.reached is not None else "not reached in %.0f s" % self.duration,
-                       path, len(states), len(touches), touches[:3]))
+                       path, len(states), len(events), events[:3]))
         rospy.loginfo(summary)
         print("FIGURES " + summary)
         self.assertTrue(self.placed, "the controller's set_model_state failed")

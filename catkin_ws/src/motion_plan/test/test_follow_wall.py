@@ -90,11 +90,12 @@ class FollowWallTest(unittest.TestCase):
                    if not (self.min_wall <= r <= self.max_wall and a >= self.min_wall)]
         summary = ("wall found at %.1f s; wall on the right at %.3f..%.3f m over %d scans, "
                    "nearest anything %.3f m (%d scans outside %.1f..%.1f m); turned %.2f turns; "
-                   "path %.1f m; %d touch event(s)" % (
+                   "path %.1f m; %d contact event(s)" % (
                        nearest[found][0] - self.start, min(following), max(following),
                        len(following), closest, len(outside),
                                           self.min_wall, self.max_wall, turned / math.tau, path,
-                                          len(touches)))
+                                          len(self.contacts.contact_events(
+                                              self.start, self.end))))
         rospy.loginfo(summary)
         print("FIGURES " + summary)
         self.assertEqual(outside[:10], [])

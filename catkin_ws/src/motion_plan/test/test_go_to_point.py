@@ -95,13 +95,14 @@ class GoToPointTest(unittest.TestCase):
         finally:
             self.switch(False)
         touches = self.contacts.touches[touches_before:]
+        events = self.contacts.contact_events(start)
         rospy.loginfo("goal (%.1f, %.1f): nearest %.3f m, at rest %.3f m from it (%.3f m/s), "
-                      "reached after %s s of sim time, %d touch event(s) %s", goal[0], goal[1],
+                      "reached after %s s of sim time, %d contact event(s) %s", goal[0], goal[1],
                       nearest, distance, v,
                       "%.2f" % reached_at if reached_at is not None else "(never)",
-                      len(touches), touches[:3])
-        print("FIGURES goal=(%.1f,%.1f) nearest=%.3f final=%.3f time=%s contacts=%d"
-              % (goal[0], goal[1], nearest, distance, reached_at, len(touches)))
+                      len(events), events[:3])
+        print("FIGURES goal=(%.1f,%.1f) nearest=%.3f final=%.3f time=%s contact_events=%d"
+              % (goal[0], goal[1], nearest, distance, reached_at, len(events)))
         return nearest, reached_at, touches
 
     def test_reaches_each_goal_from_0_8(self):

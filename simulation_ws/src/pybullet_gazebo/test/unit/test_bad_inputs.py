@@ -28,6 +28,17 @@ SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 STEP = 0.005                        # [s]
 BARRIER_THICKNESS = 0.3063          # [m] upright box of a jersey barrier
 WALL_LIMIT = 9.5                    # [m] every perimeter barrier's centre line is beyond +-9.29
+# [m] where both walls of each pair stand (tutorial_worlds.md); the corners are open: a robot
+# sliding along a wall's end may leave the yard there (with Gazebo's wheel-ground friction 1
+# the reversing robot of command1 does), which is no tunnelling
+WALLS_ALONG_X = (-7.48, 8.49)       # north and south walls
+WALLS_ALONG_Y = (-8.36, 7.39)       # east and west walls
+
+
+def through_a_wall(x, y):
+    """True when (x, y) lies beyond a perimeter wall's centre line where the wall stands."""
+    return (abs(y) >= WALL_LIMIT and WALLS_ALONG_X[0] < x < WALLS_ALONG_X[1]) or \
+        (abs(x) >= WALL_LIMIT and WALLS_ALONG_Y[0] < y < WALLS_ALONG_Y[1])
 
 SMALL = ("<robot name='s'><link name='base'><inertial><mass value='1'/><inertia ixx='0.01' "
          "iyy='0.01' izz='0.01' ixy='0' ixz='0' iyz='0'/></inertial><collision>"
@@ -222,7 +233,7 @@ def test_huge_command_is_clamped_and_the_robot_stays_finite_and_out_of_obstacles
             assert not np.any(np.isnan(values))
         pose = world.model_pose("m2wr")
         assert all(math.isfinite(v) for v in pose.position + pose.orientation)
-        assert abs(pose.position[0]) < WALL_LIMIT and abs(pose.position[1]) < WALL_LIMIT
+        assert not through_a_wall(*pose.position[:2]), pose.position
         assert -0.05 < pose.position[2] < 1.5               # on or near the ground
         for point in client.getContactPoints(bodyA=robot.body_id):
             if not world.entities[world._body_owner[point[2]]].is_ground:

@@ -136,3 +136,41 @@ def test_a_reset_forgets_the_silence():
     start = time.monotonic()
     lock.wait_if_due(0.05, lambda: True)                       # waited for, not skipped
     assert lock.commands == 1 and time.monotonic() - start >= 0.04 and len(timeouts) == 1
+
+
+def test_a_loop_whose_tick_lies_after_the_update_is_stepped_past_without_a_timeout():
+    """A behaviour switched on just after its loop ticked answers only at its next tick,
+    after the drive's update: even the wake-up /clock brings no answer. Lockstep steps on
+    after STEP_ON_AFTER (the command reaches the wheels one update later, as in Gazebo),
+    reports no silence, and waits for the next scan's answer as usual."""
+    woken, timeouts = [], []
+    lock = Lockstep(True, 1.0, on_timeout=lambda: timeouts.append(True),
+                    is_shutdown=lambda: False, before_wait=lambda: woken.append(True))
+    lock.expect_answer(commands_before=lock.commands, needed_at=0.045)
+    start = time.monotonic()
+    assert lock.wait_if_due(0.045, lambda: True) is True
+    waited = time.monotonic() - start
+    assert woken == [True] and timeouts == []
+    assert Lockstep.STEP_ON_AFTER * 0.9 < waited < 0.9          # not the 1 s timeout
+    lock.command_arrived()                                      # its tick came: it answers
+    lock.expect_answer(commands_before=lock.commands, needed_at=0.095)
+    threading.Timer(0.05, lock.command_arrived).start()
+    lock.wait_if_due(0.095, lambda: True)
+    assert lock.commands == 2 and timeouts == [] and lock.stats.step_ons == 1
+
+
+def test_true_silence_is_reported_once_after_the_timeout_in_all():
+    """Every controller switched off: scans step on after STEP_ON_AFTER each until no command
+    has come for `timeout`; then one report, and no more waiting."""
+    lock, timeouts = make(timeout=0.6)
+    start, scan = time.monotonic(), 0
+    while not timeouts and scan < 20:
+        lock.expect_answer(commands_before=lock.commands, needed_at=0.05 * scan)
+        lock.wait_if_due(0.05 * scan, lambda: True)
+        scan += 1
+    silent_after = time.monotonic() - start
+    assert len(timeouts) == 1 and 0.55 < silent_after < 1.2 and scan >= 3
+    lock.expect_answer(commands_before=lock.commands, needed_at=1.0)
+    start = time.monotonic()
+    lock.wait_if_due(1.0, lambda: True)                         # silent: no wait any more
+    assert time.monotonic() - start < 0.05 and len(timeouts) == 1

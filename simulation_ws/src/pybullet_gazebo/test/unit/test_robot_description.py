@@ -10,7 +10,8 @@ import xacro
 from pybullet_utils.bullet_client import BulletClient
 
 from pybullet_gazebo.engine.robot_description import (
-    RobotDescriptionError, effective_link_friction, parse_robot, strip_for_bullet)
+    RobotDescriptionError, effective_link_contact, effective_link_friction, parse_robot,
+    strip_for_bullet)
 from pybullet_gazebo.engine.specs import PluginSpec
 from pybullet_gazebo.engine.transforms import Pose
 
@@ -204,11 +205,11 @@ def test_unknown_plugin_is_kept_by_filename():
 
 
 def test_unknown_tags_in_a_gazebo_block_warn_once_each():
-    block = ('<gazebo reference="base"><selfCollide>true</selfCollide><kp>1e6</kp>'
+    block = ('<gazebo reference="base"><selfCollide>true</selfCollide><minDepth>0.001</minDepth>'
              '<material>Gazebo/Red</material></gazebo><gazebo><static>true</static></gazebo>')
     warnings = parse_robot(urdf(block), "m").warnings
     assert len(warnings) == 3
-    assert "<selfCollide>" in warnings[0] and "<kp>" in warnings[1]
+    assert "<selfCollide>" in warnings[0] and "<minDepth>" in warnings[1]
     assert "<static>" in warnings[2]
 
 
@@ -237,3 +238,32 @@ def test_gazebo_mu_sets_link_friction_and_wins_over_collision_surfaces():
     block = '<gazebo reference="base"><mu1>0.9</mu1><mu2>0.8</mu2></gazebo>'
     overridden = parse_robot(urdf(joint + block, root=link), "m")
     assert effective_link_friction(overridden)["base"] == (0.9, 0.8)
+
+
+def test_gazebo_kp_kd_set_the_link_contact_spring_and_win_over_collision_surfaces():
+    link = ('<link name="base"><collision name="pad"><geometry><sphere radius="0.1"/>'
+            '</geometry><surface><contact><ode><kp>5e4</kp><kd>20</kd></ode></contact>'
+            '</surface></collision><collision><geometry><box size="1 1 1"/></geometry>'
+            '<surface><contact><ode><kp>1e6</kp></ode></contact></surface></collision></link>'
+            '<link name="wheel"/><link name="other"/>')
+    joints = ('<joint name="j" type="fixed"><parent link="base"/><child link="wheel"/></joint>'
+              '<joint name="k" type="fixed"><parent link="base"/><child link="other"/></joint>')
+    block = '<gazebo reference="wheel"><kp>1e5</kp></gazebo>'
+    spec = parse_robot(urdf(joints + block, root=link), "m")
+    assert spec.warnings == ()
+    assert spec.collision_contact == {("base", "pad"): (5e4, 20.0), ("base", "1"): (1e6, None)}
+    # the softest collision of a link; a value given nowhere is SDF's default (kd 1)
+    assert effective_link_contact(spec) == {"base": (5e4, 20.0), "wheel": (1e5, 1.0)}
+    block = '<gazebo reference="base"><kd>3</kd></gazebo>'
+    spec = parse_robot(urdf(joints + block, root=link), "m")
+    assert effective_link_contact(spec)["base"] == (5e4, 3.0)
+
+
+def test_m2wr_has_gazebo_default_contact_springs(m2wr):
+    assert effective_link_contact(m2wr) == {}           # every link: kp 1e12, kd 1
+
+
+def test_a_bad_kp_is_refused_naming_the_link():
+    block = '<gazebo reference="base"><kp>-5</kp></gazebo>'
+    with pytest.raises(RobotDescriptionError, match=r'reference="base".*<kp> -5'):
+        parse_robot(urdf(block), "m")

@@ -2,7 +2,8 @@
 stand-in can simulate. A link becomes a rigid body in maximal coordinates (world02 steps 15 %
 faster than with multibodies), or a multibody when it holds a plane (pybullet cannot report a
 maximal body's shapes, and the ground checks read the plane back). A static model's bodies
-have no mass. A triangle mesh goes to Bullet as an OBJ file: a concave triangle mesh on a
+have no mass. Friction and contact stiffness/damping as surface.py turns Gazebo's into
+Bullet's. A triangle mesh goes to Bullet as an OBJ file: a concave triangle mesh on a
 static body, its convex hull on a dynamic one (Bullet collides concave meshes only when
 static); the ray caster gets its triangles (shape_data).
 """
@@ -13,7 +14,7 @@ from typing import List
 
 import pybullet
 
-from . import mesh_files
+from . import mesh_files, surface
 from .specs import Box, Cylinder, LinkSpec, Mesh, ModelSpec, Plane, Sphere, TriangleMesh
 from .transforms import Pose
 
@@ -72,7 +73,9 @@ def _create_link_body(client, model, link, collisions):
         # (the mass again: without it pybullet 3.2 sets a maximal body's mass to 0 -> NaN)
         client.changeDynamics(body, -1, mass=mass, localInertiaDiagonal=list(inertial.inertia),
                               activationState=pybullet.ACTIVATION_STATE_ENABLE_SLEEPING)
-    client.changeDynamics(body, -1, lateralFriction=collisions[0].mu)
+    # Bullet's friction and contact spring are per body: the lowest mu, the softest spring
+    surface.apply(client, body, -1, surface.bullet_friction(min(c.mu for c in collisions)),
+                  surface.Contact(min(c.kp for c in collisions), max(c.kd for c in collisions)))
     return body
 
 

@@ -26,7 +26,9 @@ collisions. For each link:
    fault: no warning is given for it.
 3. Otherwise the link is not listed and takes Gazebo's default (mu = mu2 = 1).
 A value missing from a pair (`<mu1>` without `<mu2>`, `<mu>` without `<mu2>`) is 1, SDF's
-default. Collision keys are (link name, collision name), or (link name, "N") for the N-th
+default. Contact stiffness and damping (`<gazebo reference>` `<kp>`/`<kd>`, or a collision's
+`<surface><contact><ode><kp>/<kd>`) follow the same rule (`effective_link_contact`; the
+softest collision's values), with SDF's defaults 1e12 N/m and 1 N s/m. Collision keys are (link name, collision name), or (link name, "N") for the N-th
 (0-based) collision of the link when it has no name.
 
 No pybullet here: plain XML (xml.etree) in, `specs` dataclasses and text out.
@@ -46,6 +48,8 @@ class RobotDescriptionError(Exception):
 
 
 DEFAULT_MU = 1.0                     # SDF's (ODE's) default friction coefficient
+DEFAULT_KP = 1e12                    # [N/m] SDF's default <contact><ode><kp>
+DEFAULT_KD = 1.0                     # [N s/m] SDF's default <contact><ode><kd>
 
 # The elements a URDF may hold, per parent; strip_for_bullet drops everything else.
 # `contact` under `link` is pybullet's own URDF extension and is kept for it.
@@ -77,6 +81,7 @@ def parse_robot(urdf_xml: str, model_name: str) -> RobotSpec:
     plugins: List[PluginSpec] = []
     sensors: List[RaySensorSpec] = []
     mu_given: Dict[str, List[Optional[float]]] = {}
+    contact_given: Dict[str, List[Optional[float]]] = {}
 
     for block in root.findall("gazebo"):
         reference = block.get("reference")
@@ -104,6 +109,10 @@ def parse_robot(urdf_xml: str, model_name: str) -> RobotSpec:
                 pair = mu_given.setdefault(reference, [None, None])
                 pair[0 if child.tag == "mu1" else 1] = _float(child, "%s <%s>" % (where,
                                                                                   child.tag))
+            elif child.tag in ("kp", "kd"):
+                pair = contact_given.setdefault(reference, [None, None])
+                pair[0 if child.tag == "kp" else 1] = _contact_value(
+                    child.tag, _float(child, "%s <%s>" % (where, child.tag)), where)
             elif child.tag == "material":
                 pass                       # a colour: nothing to simulate
             elif child.tag == "sensor":
@@ -120,9 +129,11 @@ def parse_robot(urdf_xml: str, model_name: str) -> RobotSpec:
 
     link_friction = {link: tuple(DEFAULT_MU if v is None else v for v in pair)
                      for link, pair in mu_given.items()}
+    link_contact = {link: tuple(pair) for link, pair in contact_given.items()}
     return RobotSpec(name=model_name, root_link=root_link, plugins=tuple(plugins),
                      sensors=tuple(sensors), link_friction=link_friction,
                      collision_friction=_collision_friction(root),
+                     link_contact=link_contact, collision_contact=_collision_contact(root),
                      warnings=tuple(warnings), links=tuple(links), joints=joints, urdf=root)
 
 
@@ -156,6 +167,25 @@ def driven_wheel_links(spec: RobotSpec, plugin_keys) -> set:
     joint_names = {value for plugin in spec.plugins if plugin.filename in plugin_keys
                    for key, value in plugin.params.items() if key in ("leftJoint", "rightJoint")}
     return {spec.joints[name][1] for name in joint_names if name in spec.joints}
+
+
+def effective_link_contact(spec: RobotSpec) -> Dict[str, Tuple[float, float]]:
+    """(kp, kd) for every link the description gives a contact stiffness or damping: the
+    link's <gazebo> kp/kd, else the softest (lowest kp, highest kd) of its collisions'
+    <surface><contact><ode> values; a value not given anywhere is SDF's default."""
+    result: Dict[str, list] = {}
+    for (link, _), (kp, kd) in spec.collision_contact.items():
+        pair = result.setdefault(link, [None, None])
+        if kp is not None:
+            pair[0] = kp if pair[0] is None else min(kp, pair[0])
+        if kd is not None:
+            pair[1] = kd if pair[1] is None else max(kd, pair[1])
+    for link, (kp, kd) in spec.link_contact.items():
+        pair = result.setdefault(link, [None, None])
+        pair[0] = kp if kp is not None else pair[0]
+        pair[1] = kd if kd is not None else pair[1]
+    return {link: (DEFAULT_KP if kp is None else kp, DEFAULT_KD if kd is None else kd)
+            for link, (kp, kd) in result.items()}
 
 
 def effective_link_friction(spec: RobotSpec) -> Dict[str, Tuple[float, float]]:
@@ -431,6 +461,31 @@ def _collision_friction(root):
                 continue
             result[key] = (DEFAULT_MU if mu is None else mu, DEFAULT_MU if mu2 is None else mu2)
     return result
+
+
+def _collision_contact(root):
+    result = {}
+    for link in root.findall("link"):
+        for index, collision in enumerate(link.findall("collision")):
+            ode = collision.find("surface/contact/ode")
+            if ode is None:
+                continue
+            key = (link.get("name"), collision.get("name") or str(index))
+            where = "link '%s' collision '%s' <surface><contact><ode>" % key
+            kp = _number(ode, "kp", where, None)
+            kd = _number(ode, "kd", where, None)
+            if kp is None and kd is None:
+                continue
+            result[key] = (None if kp is None else _contact_value("kp", kp, where),
+                           None if kd is None else _contact_value("kd", kd, where))
+    return result
+
+
+def _contact_value(tag, value, where):
+    if (tag == "kp" and not value > 0.0) or (tag == "kd" and not value >= 0.0):
+        raise RobotDescriptionError("%s: <%s> %g must be %s; fix the value" % (
+            where, tag, value, "above 0 [N/m]" if tag == "kp" else "0 or more [N s/m]"))
+    return value
 
 
 def _strip(element):

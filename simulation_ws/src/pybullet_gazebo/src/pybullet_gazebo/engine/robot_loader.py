@@ -1,6 +1,6 @@
 """A URDF robot into Bullet: the description parsed once, cleaned for pybullet's loader (with
 ground-contact spheres on the driven wheels, see wheel_contact), loaded at a pose, its joints
-freed and its links given Gazebo's friction, and the parts its `<gazebo>` tags ask for built
+freed and its links given Gazebo's friction and contact stiffness/damping (surface.py), and the parts its `<gazebo>` tags ask for built
 from the registry. A tag the registry does not know is reported by name.
 """
 import os
@@ -8,13 +8,14 @@ import tempfile
 
 import pybullet
 
-from . import wheel_contact
+from . import surface, wheel_contact
 from .diff_drive import DiffDrive
 from .entities import Robot
 from .joint_states import JointStatePublisher
 from .part import PartContext
 from .registry import PLUGIN_PARTS, SENSOR_PARTS, SENSOR_PLUGINS
-from .robot_description import (DEFAULT_MU, bullet_tree, driven_wheel_links,
+from .robot_description import (DEFAULT_KD, DEFAULT_KP, DEFAULT_MU, bullet_tree,
+                                driven_wheel_links, effective_link_contact,
                                 effective_link_friction, urdf_text)
 from .specs import RobotSpec
 from .transforms import Pose
@@ -50,9 +51,11 @@ def load_body(client, spec: RobotSpec, pose: Pose):
 
 
 def make_robot(client, body, spec: RobotSpec, pose, namespace, contacts, caster, rng, warn,
-               command_timeout=0.0, legacy_mode_swaps=False, kinetic_legacy_mode=False) -> Robot:
+               command_timeout=0.0, legacy_mode_swaps=False, kinetic_legacy_mode=False,
+               ground_mu=None) -> Robot:
     """The Robot of a loaded body: joints freed (Gazebo's joints are free until a plugin
-    drives them), friction per link, collision groups, and its parts. SpawnError when a
+    drives them), friction and contact spring per link (surface.py; `ground_mu`: the
+    ground's mu, None without a ground), collision groups, and its parts. SpawnError when a
     sensor sits on a link the URDF lacks or a part cannot be built; `warn` gets each tag the
     stand-in does not simulate."""
     joints, links = {}, {spec.root_link: -1}
@@ -62,9 +65,14 @@ def make_robot(client, body, spec: RobotSpec, pose, namespace, contacts, caster,
         links[info[12].decode()] = index
         client.setJointMotorControl2(body, index, pybullet.VELOCITY_CONTROL, force=0.0)
     friction = effective_link_friction(spec)      # Bullet's friction is per link
+    contact = effective_link_contact(spec)
+    surfaces = {}                                 # link: (Gazebo's mu, contact spring)
     for link, index in links.items():
-        client.changeDynamics(body, index, lateralFriction=friction.get(link, (DEFAULT_MU,))[0])
-    wheel_contact.apply_groups(client, body, links, contacts)
+        surfaces[link] = (friction.get(link, (DEFAULT_MU,))[0],
+                          surface.Contact(*contact.get(link, (DEFAULT_KP, DEFAULT_KD))))
+        surface.apply(client, body, index, surface.bullet_friction(surfaces[link][0]),
+                      surfaces[link][1])
+    wheel_contact.apply_groups(client, body, links, contacts, surfaces, ground_mu)
     robot = Robot(spec.name, body, namespace, joints, links, pose)
     context = PartContext(client, body, spec.name, joints, links, spec, caster, rng,
                           warn=lambda m: warn("model '%s': %s" % (spec.name, m)),

@@ -8,7 +8,8 @@ What is read
 - `<model>`: name, `<static>`, `<pose>`; each `<link>` with `<pose>`, `<inertial>` (mass [kg],
   pose, ixx iyy izz [kg m^2]; without one, Gazebo's default of 1 kg and unit inertia) and
   `<collision>`s with `<pose>`, `<geometry>` box / cylinder / sphere / plane / mesh and
-  `<surface><friction><ode><mu>/<mu2>` (default 1, as Gazebo's ODE).
+  `<surface><friction><ode><mu>/<mu2>` (default 1, as Gazebo's ODE) and
+  `<surface><contact><ode><kp>/<kd>` (defaults 1e12 N/m and 1 N s/m, SDF's); see surface.py.
   A nested `<model>` or `<include>` inside a model is flattened into it: its links become links
   of the outer model named `inner::link`, with their poses composed into the outer model frame.
 - `<include>` of `<uri>model://NAME</uri>` with optional `<name>`, `<pose>`, `<static>`
@@ -63,6 +64,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import replace
 
 from . import mesh_files
+from . import surface as surface_defaults
 from .appearance import sdf_link_colour
 from .specs import (Box, CollisionSpec, Cylinder, InertialSpec, LinkSpec, Mesh, ModelSpec,
                     PhysicsSpec, Plane, Sphere, TriangleMesh, WorldSpec)
@@ -434,6 +436,7 @@ class _WorldReader:
         geometry = self.geometry(geometry_elem, owner, where) if geometry_elem is not None \
             else None
         mu, mu2 = 1.0, 1.0
+        kp, kd = surface_defaults.DEFAULT_KP, surface_defaults.DEFAULT_KD
         surface = elem.find("surface")
         if surface is not None:
             friction = surface.find("friction")
@@ -444,12 +447,24 @@ class _WorldReader:
                     mu2 = self.number(ode, "mu2", mu2, owner)
                     self.check_rest(ode, {"mu", "mu2"}, owner, "<friction><ode> of " + where)
                 self.check_rest(friction, {"ode"}, owner, "<friction> of " + where)
-            self.check_rest(surface, {"friction"}, owner, "<surface> of " + where)
+            contact = surface.find("contact")
+            if contact is not None:
+                ode = contact.find("ode")
+                if ode is not None:
+                    kp = self.number(ode, "kp", kp, owner)
+                    kd = self.number(ode, "kd", kd, owner)
+                    if not (kp > 0.0 and kd >= 0.0):
+                        raise self.error("%s: <kp> %g and <kd> %g of the <contact><ode> of %s "
+                                         "must be kp > 0 and kd >= 0; fix the values"
+                                         % (owner, kp, kd, where))
+                    self.check_rest(ode, {"kp", "kd"}, owner, "<contact><ode> of " + where)
+                self.check_rest(contact, {"ode"}, owner, "<contact> of " + where)
+            self.check_rest(surface, {"friction", "contact"}, owner, "<surface> of " + where)
         self.check_rest(elem, {"pose", "geometry", "surface"}, owner, where)
         if geometry is None:
             return None
         return CollisionSpec(name=name, geometry=geometry, pose=self.pose(elem, owner),
-                             mu=mu, mu2=mu2)
+                             mu=mu, mu2=mu2, kp=kp, kd=kd)
 
     def geometry(self, elem, owner, where):
         shapes = list(elem)
@@ -540,7 +555,7 @@ class _WorldReader:
                         pose=collision.pose.compose(Pose(
                             tuple(p * k for p, k in zip(c.pose.position, scale)),
                             c.pose.orientation)),
-                        mu=collision.mu, mu2=collision.mu2)
+                        mu=collision.mu, mu2=collision.mu2, kp=collision.kp, kd=collision.kd)
                 for c in primitives]
 
     def replace_meshes(self, links, model_dir, owner):

@@ -61,6 +61,8 @@ class CollisionSpec:
     pose: Pose = Pose()                       # in the link frame
     mu: float = 1.0                           # Gazebo's (ODE) default friction
     mu2: float = 1.0
+    kp: float = 1e12                          # [N/m] <contact><ode><kp>, SDF's default
+    kd: float = 1.0                           # [N s/m] <contact><ode><kd>, SDF's default
 
 
 @dataclass(frozen=True)
@@ -142,6 +144,11 @@ class RobotSpec:
     sensors: Tuple[RaySensorSpec, ...] = ()
     link_friction: Dict[str, Tuple[float, float]] = field(default_factory=dict)  # link: (mu1, mu2)
     collision_friction: Dict[Tuple[str, str], Tuple[float, float]] = field(default_factory=dict)
+    # link: (kp [N/m], kd [N s/m]) from <gazebo reference> <kp>/<kd>, each None when not given
+    link_contact: Dict[str, Tuple[Optional[float], Optional[float]]] = field(default_factory=dict)
+    # (link, collision): (kp, kd) from <surface><contact><ode>, each None when not given
+    collision_contact: Dict[Tuple[str, str], Tuple[Optional[float], Optional[float]]] = field(
+        default_factory=dict)
     warnings: Tuple[str, ...] = ()
     links: Tuple[str, ...] = ()               # link names, in file order
     joints: Dict[str, Tuple[str, str]] = field(default_factory=dict)   # name: (parent, child)

@@ -13,10 +13,14 @@ when each one's group is in the other's mask):
                   would otherwise cost a plane-box test per step: half of world02's step)
   contact sphere  group CONTACT, mask GROUND
   wheel cylinder  group 1, mask ALL but GROUND and CONTACT
+Touching only the ground lets the sphere's friction be chosen so that its pair with the
+ground gets exactly Gazebo's friction, min(mu_wheel, mu_ground) (see surface.py).
   everything else Bullet's defaults (dynamic: group 1, mask ALL; static: group 2, mask ALL
                   but 2), which never include CONTACT in their group
 """
 import xml.etree.ElementTree as ET
+
+from . import surface
 
 DEFAULT, STATIC = 1, 2         # Bullet's groups of dynamic and of static bodies
 GROUND, CONTACT = 64, 128      # bits Bullet itself does not use
@@ -66,16 +70,21 @@ def add_contact_links(root, wheel_links):
     return added
 
 
-def apply_groups(client, body, links, contacts):
-    """Sets the collision groups of a loaded robot, and gives each contact sphere its wheel's
-    friction: `links` maps link names to indices, `contacts` is add_contact_links' result.
-    Call it after the wheels' friction is set."""
+def apply_groups(client, body, links, contacts, surfaces, ground_mu=None):
+    """Sets the collision groups of a loaded robot, and gives each contact sphere its
+    wheel's contact spring and the friction that makes the sphere-ground pair Gazebo's
+    min(mu_wheel, mu_ground) (surface.ground_contact_friction). `links` maps link names to
+    indices, `contacts` is add_contact_links' result, `surfaces` maps links to (Gazebo's mu,
+    surface.Contact), `ground_mu` is the ground's mu (None: no ground yet)."""
     for wheel, contact in contacts.items():
         client.setCollisionFilterGroupMask(body, links[wheel], DEFAULT, ALL & ~(GROUND | CONTACT))
         client.setCollisionFilterGroupMask(body, links[contact], CONTACT, GROUND)
-        wheel_friction = client.getDynamicsInfo(body, links[wheel])[1]   # the wheel's mu
-        client.changeDynamics(body, links[contact], lateralFriction=wheel_friction,
-                              spinningFriction=SPINNING_FRICTION, frictionAnchor=FRICTION_ANCHOR)
+        mu, spring = surfaces[wheel]
+        friction = surface.bullet_friction(mu) if ground_mu is None \
+            else surface.ground_contact_friction(mu, ground_mu)
+        surface.apply(client, body, links[contact], friction, spring)
+        client.changeDynamics(body, links[contact], spinningFriction=SPINNING_FRICTION,
+                              frictionAnchor=FRICTION_ANCHOR)
 
 
 def mark_ground(client, body):

@@ -262,7 +262,8 @@ class World:
             robot = make_robot(self.client, body, spec, pose, namespace, contacts, self.caster,
                                self.rng, self.warn, command_timeout=self.command_timeout,
                                legacy_mode_swaps=self.legacy_mode_swaps,
-                               kinetic_legacy_mode=self.legacy_mode)
+                               kinetic_legacy_mode=self.legacy_mode,
+                               ground_mu=self._ground_mu())
             self._warn_overlap(name, [body], pose)
             grounds = [(b, owner) for b, owner in self._body_owner.items()
                        if self.entities[owner].is_ground]
@@ -282,6 +283,15 @@ class World:
         self._body_owner[body] = name
         self.caster.add_body(body, static=False)
         return robot
+
+    def _ground_mu(self):
+        """Gazebo's mu of the ground (the first ground model by name, its lowest), for the
+        wheels' ground contact (wheel_contact); None without a ground."""
+        for name in sorted(self._grounds):
+            mus = [c.mu for link in self.entities[name].link_specs for c in link.collisions]
+            if mus:
+                return min(mus)
+        return None
 
     def _checked_new_model(self, name, pose) -> Pose:
         """The spawn pose, normalised; SpawnError for an empty or taken name or a bad pose."""

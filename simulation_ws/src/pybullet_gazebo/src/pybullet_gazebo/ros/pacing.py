@@ -11,12 +11,18 @@ The answer then reaches the wheels at the same sim time on every run.
 
 Controllers that publish from their own loop (rospy.Rate, as the series' later programs do)
 wake on /clock, not on scans: when no answer came within WAKE_AFTER of wall time,
-`before_wait` is called (the node brings /clock up to now), so a loop whose tick fell since the last /clock publishes its command before the
-drive reads it. When no command comes within `timeout` (every controller switched off, say),
-lockstep reports it once and stops waiting until the next command arrives, instead of
-stalling `timeout` at every scan. Time spent paused is not silence: a pause (an agent that
-thinks between steps, a user at the GUI) interrupts the wait, and the wait starts afresh, for
-the same answer, once physics runs again. A reset forgets both the awaited answer and the
+`before_wait` is called (the node brings /clock up to now), so a loop whose tick fell since
+the last /clock publishes its command before the drive reads it. A loop whose next tick lies
+after the drive's update cannot answer before it (in Gazebo its command too reaches the
+wheels one update later): seen in the series' bug programs when a behaviour is switched on
+just after its loop ticked. So when no answer came within STEP_ON_AFTER of the scan's wait,
+lockstep steps on without a word (before: it stalled the whole `timeout`, 1 s, and logged
+`no cmd_vel within`). When no command at all comes for `timeout` (every controller switched
+off, say), lockstep reports it once and stops waiting until the next command arrives,
+instead of stalling at every scan. A controller that answers scans is waited for up to
+STEP_ON_AFTER: far more than it takes even on a loaded machine (a few ms). Time spent paused
+is not silence: a pause (an agent that thinks between steps, a user at the GUI) interrupts
+the wait, and the wait starts afresh, for the same answer, once physics runs again. A reset forgets both the awaited answer and the
 silence (a new episode: its controller is waited for again).
 """
 import threading
@@ -44,8 +50,25 @@ class RealTimePacer:
             self.restart(sim_time)
 
 
+class LockstepStats:
+    """What lockstep cost in a run, for the simulator's run summary."""
+
+    def __init__(self):
+        self.waits = 0              # scans whose answer was not in when the drive needed it
+        self.wake_ups = 0           # of those, waits that needed the wake-up /clock
+        self.step_ons = 0           # waits that ended without an answer, stepping on
+        self.timeouts = 0           # of those, the ones that found the controllers silent
+        self.wall_waiting = 0.0     # [s] wall spent in those waits
+
+    def summary(self):
+        return ("%d waits for a cmd_vel (%d needed the wake-up /clock, %d stepped on without "
+                "an answer, %d found the controllers silent), %.1f s of wall time waiting"
+                % (self.waits, self.wake_ups, self.step_ons, self.timeouts, self.wall_waiting))
+
+
 class Lockstep:
     WAKE_AFTER = 0.005        # [s] wall: how long an answer may take before the wake-up /clock
+    STEP_ON_AFTER = 0.25      # [s] wall: no answer this long after a scan: step on (see above)
 
     def __init__(self, enabled, timeout, on_timeout, is_shutdown, before_wait=lambda: None,
                  is_paused=lambda: False):
@@ -56,9 +79,11 @@ class Lockstep:
         self.is_paused = is_paused           # physics paused: a wait ends without a verdict
         self.before_wait = before_wait       # called before waiting for an answer not yet in
         self.commands = 0                    # commands received since the start
+        self.stats = LockstepStats()
         self.silent_at = None                # commands counted when a wait last timed out
         self._arrived = threading.Condition()
         self._awaited = None                 # (commands counted at a scan, sim time needed by)
+        self._quiet = None                   # (commands counted, wall time) unanswered since
 
     def command_arrived(self):
         with self._arrived:
@@ -75,6 +100,7 @@ class Lockstep:
         """A reset: no answer awaited, and no controller taken as silent any more."""
         self._awaited = None
         self.silent_at = None
+        self._quiet = None
 
     def wait_if_due(self, sim_time, anyone_commands):
         """Before a step at `sim_time`: waits for the awaited answer if it is needed now and
@@ -87,19 +113,35 @@ class Lockstep:
                 or not anyone_commands():
             self._awaited = None
             return True             # answered already, controllers silent, or none at all
-        deadline = time.monotonic() + self.timeout
+        started = time.monotonic()
+        if self._quiet is not None and self._quiet[0] != self.commands:
+            self._quiet = None                       # a command came since: not quiet
         # a controller that answers scans is usually a few ms away: no wake-up /clock for it
         # (each /clock wakes every node); one on its own loop gets it after WAKE_AFTER
-        outcome = self._wait_for(awaited[0], min(deadline, time.monotonic() + self.WAKE_AFTER))
+        outcome = self._wait_for(awaited[0], started + min(self.WAKE_AFTER, self.timeout))
+        self.stats.waits += 1
         if outcome is None:
+            self.stats.wake_ups += 1
             self.before_wait()
-            outcome = self._wait_for(awaited[0], deadline)
+            outcome = self._wait_for(awaited[0], started + min(self.STEP_ON_AFTER,
+                                                               self.timeout))
+        self.stats.wall_waiting += time.monotonic() - started
         if outcome is False:                         # paused: wait again after the pause
+            self._quiet = None
             return False
         self._awaited = None
-        if outcome is None:
-            self.silent_at = self.commands
-            self.on_timeout()
+        if outcome:
+            self._quiet = None
+            return True
+        if self._quiet is None:
+            self._quiet = (self.commands, started)
+        if time.monotonic() - self._quiet[1] < self.timeout:
+            self.stats.step_ons += 1                 # its tick lies beyond the update
+            return True
+        self._quiet = None
+        self.stats.timeouts += 1
+        self.silent_at = self.commands
+        self.on_timeout()
         return True
 
     def _wait_for(self, commands_before, deadline):

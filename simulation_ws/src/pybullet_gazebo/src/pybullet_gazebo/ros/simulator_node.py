@@ -162,7 +162,16 @@ class SimulatorNode:
             self._loop()
         finally:
             self._running = False
+            self._log_run_summary()
             self._disconnect()
+
+    def _log_run_summary(self):
+        """One line at the end of a run: sim time, contact events, what lockstep cost."""
+        rospy.loginfo("run summary: %.2f s of sim time in %d steps; %d contact event(s) (a "
+                      "robot starting to touch a model)%s", self.world.sim_time,
+                      self.world.step_count, self.world.contacts.event_count,
+                      "; lockstep: " + self.lockstep.stats.summary()
+                      if self.params.lockstep else "")
 
     def _loop(self):
         while not rospy.is_shutdown():

@@ -105,6 +105,8 @@ class ContactLog:
         from gazebo_msgs.msg import ContactsState
         self.topic = topic
         self._touches = []
+        self._events = []                   # (sim time, robot, model) of each touch onset
+        self._touching = set()
         self.messages = 0
         self._sub = rospy.Subscriber(topic, ContactsState, self._on_contacts, queue_size=1000)
 
@@ -115,8 +117,18 @@ class ContactLog:
                                  "(param /gazebo/contacts) to see touches" % self.topic)
         return self._touches
 
+    def contact_events(self, start=0.0, end=float("inf")):
+        """The touch onsets (sim time [s], robot, model) from `start` to `end` [s sim]: a
+        pair counts when it starts touching, as the simulator's run summary counts them."""
+        self.touches                       # asserts that someone publishes the topic
+        return [e for e in self._events if start <= e[0] <= end]
+
     def _on_contacts(self, msg):
         self.messages += 1
+        pairs = {(s.collision1_name, s.collision2_name) for s in msg.states}
+        for robot, model in sorted(pairs - self._touching):
+            self._events.append((msg.header.stamp.to_sec(), robot, model))
+        self._touching = pairs
         if msg.states:
             self._touches.append((msg.header.stamp.to_sec(),
                                   ["%s touches %s" % (s.collision1_name, s.collision2_name)
