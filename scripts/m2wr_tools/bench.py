@@ -22,8 +22,11 @@ Figures:
                     scans, simulator RSS at start and end (growth %), ERROR lines in the logs
   listeners         the lockstep loop again with a /gazebo/model_states subscriber,
                     robot_state_publisher and /tf and /joint_states subscribers attached (what
-                    rviz and a Gazebo tool would add); printed as a ratio to the loop without,
-                    and the loop's ratio to World.step alone, both from the same run
+                    rviz and a Gazebo tool would add), with the simulator's default
+                    watch_rate (model_states and joint_states at most ~30-50 per wall second)
+                    and with watch_rate:=0 (every message at its sim-time rate, as before the
+                    limit); printed as ratios to the loop without, and the loop's ratio to
+                    World.step alone, all from the same run
 The machine is shared: the load average before and after is recorded with the figures.
 
 Where the simulator's time goes (profile recipe): run the loop (scripts/demo.sh, or
@@ -53,6 +56,7 @@ from .paths import ROOT
 from .session import Session, SessionError
 
 SIMULATOR_DEFAULT_CLOCK_HZ = 100.0
+UNLIMITED = "listeners, watch_rate 0"
 
 
 class Interrupted(Exception):
@@ -98,11 +102,14 @@ def report(figures):
     ]
     lockstep = loops.get("lockstep", {}).get("x_real_time")
     watched = loops.get("lockstep + listeners", {}).get("x_real_time")
+    unlimited = loops.get(UNLIMITED, {}).get("x_real_time")
     step_alone = engine["engine_step"]["x_real_time"]
     lines += [
         "ratios (same run):",
         "  lockstep loop with listeners / without   %s %% (target >= 90 %%)" % (
             fmt(100.0 * watched / lockstep if lockstep and watched else None, "%.0f")),
+        "    the same with watch_rate 0 (no limit)  %s %%" % (
+            fmt(100.0 * unlimited / lockstep if lockstep and unlimited else None, "%.0f")),
         "  lockstep loop / World.step alone         %s %% (target >= 60 %%)" % (
             fmt(100.0 * lockstep / step_alone if lockstep and step_alone else None, "%.0f")),
     ]
@@ -185,6 +192,9 @@ def main(argv=None):
         loops["lockstep + listeners"] = measure_loop(
             session, listener, "lockstep + listeners", True, args.clock_hz, args.seconds,
             args.check_seconds, watchers=True)
+        loops[UNLIMITED] = measure_loop(
+            session, listener, UNLIMITED, True, args.clock_hz, args.seconds,
+            args.check_seconds, watchers=True, extra=("watch_rate:=0",))
         if args.clock_hz != SIMULATOR_DEFAULT_CLOCK_HZ:
             loops["lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ] = measure_loop(
                 session, listener, "lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ, True,

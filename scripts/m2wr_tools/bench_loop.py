@@ -115,10 +115,11 @@ def wait_counting(session, timeout=10.0):
     raise SessionError("the bench's counters did not connect within %.0f s" % timeout)
 
 
-def start_loop(session, lockstep, clock_hz):
-    """Simulator (paused) + m2wr + obstacle_avoidance.py connected, ready to unpause."""
+def start_loop(session, lockstep, clock_hz, extra=()):
+    """Simulator (paused) + m2wr + obstacle_avoidance.py connected, ready to unpause;
+    `extra`: more arguments of the world's launch file."""
     session.start_episode(WORLD, START, lockstep=lockstep, real_time_factor=0.0, seed=0,
-                          pub_clock_frequency=clock_hz)
+                          pub_clock_frequency=clock_hz, extra=extra)
     return session.node_pid(SIMULATOR_NODE), session.children["controller"].pid
 
 
@@ -146,10 +147,11 @@ def stop_loop(session):
 
 
 def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_seconds, warmup=2.0,
-                 watchers=False):
-    say("%s: simulator real_time_factor 0, lockstep %s, /clock %g Hz%s" % (
-        name, str(lockstep).lower(), clock_hz, ", with listeners" if watchers else ""))
-    sim_pid, ctrl_pid = start_loop(session, lockstep, clock_hz)
+                 watchers=False, extra=()):
+    say("%s: simulator real_time_factor 0, lockstep %s, /clock %g Hz%s%s" % (
+        name, str(lockstep).lower(), clock_hz, ", with listeners" if watchers else "",
+        "".join(", " + arg for arg in extra)))
+    sim_pid, ctrl_pid = start_loop(session, lockstep, clock_hz, extra)
     try:
         if watchers:
             start_watchers(session)
@@ -184,7 +186,7 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
     finally:
         stop_loop(session)
     result = {
-        "lockstep": lockstep, "pub_clock_frequency_hz": clock_hz,
+        "lockstep": lockstep, "pub_clock_frequency_hz": clock_hz, "launch_args": list(extra),
         "x_real_time": benchmath.rate(sim_s, wall_s), "sim_s": sim_s, "wall_s": wall_s,
         "robot_touches": touches1 - touches0,
         "cpu_ms_per_sim_s": {

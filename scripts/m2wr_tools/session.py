@@ -172,13 +172,15 @@ class Session:
 
     def start_episode(self, world, start, lockstep=True, real_time_factor=0.0, seed=0,
                       pub_clock_frequency=None, gui=False, controller=TUTORIAL_CONTROLLER,
-                      say=lambda _text: None):
+                      say=lambda _text: None, extra=()):
         """The simulator paused on `world`, m2wr spawned at `start` (x [m], y [m], yaw [rad])
         and `controller` connected to its scan and cmd_vel: ready to unpause. The spawn
         starts at once (it waits for the simulator's service), the controller once the
-        simulator is up, so that /use_sim_time is set when it starts."""
+        simulator is up, so that /use_sim_time is set when it starts. `extra`: more
+        `name:=value` arguments of the world's launch file."""
         self.launch_world(world, gui=gui, real_time_factor=real_time_factor, lockstep=lockstep,
-                          seed=seed, paused=True, pub_clock_frequency=pub_clock_frequency)
+                          seed=seed, paused=True, pub_clock_frequency=pub_clock_frequency,
+                          extra=extra)
         say("spawning m2wr at x %g y %g yaw %g" % tuple(start))
         self.start_spawn(*start)
         self.wait_for_simulator()

@@ -18,36 +18,11 @@ import rosgraph
 import rospkg
 import rostest
 
+from pybullet_gazebo.ros.testing import VirtualDisplay
+
 RUNS_SIGINT = 5
 RUNS_SIGTERM = 2
 EXIT_WITHIN = 10.0          # [s] wall from the signal to the process's exit
-
-
-class VirtualDisplay:
-    """An Xvfb server on a free display number (Xvfb picks it: -displayfd), stopped by PID."""
-
-    def __init__(self):
-        read_end, write_end = os.pipe()
-        self.process = subprocess.Popen(
-            ["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24",
-             "-nolisten", "tcp"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL, start_new_session=True)
-        os.close(write_end)
-        with os.fdopen(read_end) as pipe:
-            number = pipe.readline().strip()       # written once the server accepts clients
-        if not number:
-            self.stop()
-            raise AssertionError("Xvfb did not start")
-        self.display = ":" + number
-
-    def stop(self):
-        if self.process.poll() is None:
-            self.process.terminate()
-            try:
-                self.process.wait(10)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
 
 
 class CleanShutdownTest(unittest.TestCase):

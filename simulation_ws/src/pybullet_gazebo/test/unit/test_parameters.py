@@ -72,3 +72,7 @@ def test_node_parameters_are_read_and_checked_by_the_same_reader():
         SimulatorParams.from_values({"seed": -1})
     with pytest.raises(ParameterError, match=r"~lockstep_timeout is nan; give a finite"):
         SimulatorParams.from_values({"lockstep_timeout": math.nan})
+    assert SimulatorParams.from_values({}).watch_rate == 30.0               # [Hz] wall
+    assert SimulatorParams.from_values({"watch_rate": 0}).watch_rate == 0.0  # no limit
+    with pytest.raises(ParameterError, match=r"~watch_rate is -5; it must be >= 0"):
+        SimulatorParams.from_values({"watch_rate": -5})

@@ -5,17 +5,23 @@ step's sim time, and closes them when the robot goes. A part whose KEY has no bi
 reported by name when its robot is bound.
 
   ray (libgazebo_ros_laser.so)      publishes the plugin's topicName (sensor_msgs/LaserScan)
-  libgazebo_ros_joint_state_publisher.so  publishes joint_states (sensor_msgs/JointState),
-                                    also for every diff drive's wheels (engine/joint_states.py)
+  libgazebo_ros_joint_state_publisher.so  publishes joint_states (sensor_msgs/JointState) at
+                                    the part's updateRate [Hz sim] (a diff drive's wheels: its
+                                    updateRate, engine/joint_states.py), only while someone
+                                    listens; a watching topic: faster than real time at most
+                                    max(~watch_rate, updateRate) per wall second (watch_rate.py)
   libgazebo_ros_diff_drive.so       subscribes commandTopic (geometry_msgs/Twist), publishes
                                     odometryTopic (nav_msgs/Odometry) and TF odometryFrame ->
-                                    robotBaseFrame on /tf, each only while someone listens
+                                    robotBaseFrame on /tf at its updateRate [Hz sim], each only
+                                    while someone listens, never limited in wall time
+                                    (controllers use them in lockstep)
 
 Names as gazebo_ros gives them with several robots (robot_namespace.py): topics in the
 plugin's <robotNamespace> or the spawn's namespace; the laser's frame prefixed by the
 `tf_prefix` parameter found from that namespace, the drive's frames by it or, when there is
 none, by the namespace itself (read once, when the robot is bound).
 """
+import math
 from dataclasses import dataclass
 from typing import Callable, Dict, List
 
@@ -30,14 +36,16 @@ from pybullet_gazebo.engine.joint_states import JointStatePublisher
 from pybullet_gazebo.engine.ray_sensor import RaySensor
 from pybullet_gazebo.ros import conversions, robot_namespace
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
+from pybullet_gazebo.ros.watch_rate import WallRateLimit, topic_limit
 
 
 @dataclass
 class BindingContext:
     """What the simulator node lends every binding."""
-    tf_publisher: Callable[[], rospy.Publisher]   # the node's /tf publisher, made on first use
+    tf_publisher: Callable[[], DirectPublisher]   # the node's /tf publisher, made on first use
     command_arrived: Callable[[], None]           # tells lockstep a command came in
     debug: bool = False
+    watch_rate: float = 0.0                       # [Hz wall] ~watch_rate (watch_rate.py)
 
 
 class Binding:
@@ -47,7 +55,7 @@ class Binding:
         self.robot = robot
         self.part = part
         self.context = context
-        self.publishers: List[rospy.Publisher] = []
+        self.publishers: List = []                   # rospy or DirectPublisher: unregister()
         self.subscribers: List[rospy.Subscriber] = []
         self.namespace = robot_namespace.plugin_namespace(robot.namespace, part.own_namespace)
 
@@ -90,7 +98,7 @@ class LaserBinding(Binding):
 class DriveBinding(Binding):
     def __init__(self, robot, part, context):
         super().__init__(robot, part, context)
-        self.odometry = rospy.Publisher(self.topic(part.odometry_topic), Odometry, queue_size=1)
+        self.odometry = DirectPublisher(self.topic(part.odometry_topic), Odometry)
         self.publishers.append(self.odometry)
         self.frames = (self.frame(part.odometry_frame, fall_back_to_namespace=True),
                        self.frame(part.robot_base_frame, fall_back_to_namespace=True))
@@ -132,16 +140,18 @@ class DriveBinding(Binding):
 
 class JointStateBinding(Binding):
     """joint_states (sensor_msgs/JointState) in the robot's namespace, built only while
-    someone listens (robot_state_publisher, rviz)."""
+    someone listens (robot_state_publisher, rviz), limited in wall time (watch_rate.py)."""
 
     def __init__(self, robot, part, context):
         super().__init__(robot, part, context)
         self.states = DirectPublisher(self.topic("joint_states"), JointState)
         self.publishers.append(self.states)
         self.message = JointState(name=list(part.names))
+        sim_rate = 1.0 / part.period if part.period > 0 else math.inf     # [Hz sim]
+        self.limit = WallRateLimit(topic_limit(context.watch_rate, sim_rate))
 
     def publish(self, data, stamp):
-        if self.states.get_num_connections() > 0:
+        if self.states.get_num_connections() > 0 and self.limit.allow():
             self.message.header.stamp = stamp
             self.message.position = data.positions
             self.message.velocity = data.velocities

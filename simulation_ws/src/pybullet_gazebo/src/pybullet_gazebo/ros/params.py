@@ -8,6 +8,9 @@ parameters (~name), with units:
   max_step_size       [s] fixed physics step; 0 = the world file's <max_step_size>
   pub_clock_frequency [Hz] of sim time at which /clock is published
   model_states_rate   [Hz] of sim time at which /gazebo/model_states is published
+  watch_rate          [Hz] of wall time: when the simulation runs faster than real time,
+                      model_states, link_states and joint_states go out at most max(this,
+                      their own rate) times per wall second; 0 = no limit (watch_rate.py)
   seed                seed of the sensors' noise
   lockstep            after each scan, wait for the controller's cmd_vel (see README)
   lockstep_timeout    [s] of wall time to wait for it before stepping on
@@ -31,6 +34,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 from pybullet_gazebo.engine.parameters import ROS_BOOLEANS, ParameterError, ParameterReader
+from pybullet_gazebo.ros.watch_rate import DEFAULT_WATCH_RATE
 
 __all__ = ["SimulatorParams", "ParameterError"]
 
@@ -43,6 +47,7 @@ class SimulatorParams:
     max_step_size: float = 0.005            # [s]
     pub_clock_frequency: float = 100.0      # [Hz]
     model_states_rate: float = 50.0         # [Hz]
+    watch_rate: float = DEFAULT_WATCH_RATE  # [Hz] wall
     seed: int = 0
     lockstep: bool = False
     lockstep_timeout: float = 1.0           # [s] wall
@@ -69,6 +74,7 @@ class SimulatorParams:
             pub_clock_frequency=read.number("pub_clock_frequency", d.pub_clock_frequency,
                                             above=0.0),
             model_states_rate=read.number("model_states_rate", d.model_states_rate, above=0.0),
+            watch_rate=read.number("watch_rate", d.watch_rate, minimum=0.0),
             seed=read.integer("seed", d.seed, minimum=0),
             lockstep=read.boolean("lockstep", d.lockstep),
             lockstep_timeout=read.number("lockstep_timeout", d.lockstep_timeout, above=0.0),

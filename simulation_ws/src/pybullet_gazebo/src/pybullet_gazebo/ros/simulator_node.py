@@ -5,14 +5,18 @@ gazebo_ros_api_plugin (gazebo_services.py and the modules it lists), and
 Topics out:
   /clock (rosgraph_msgs/Clock) when /use_sim_time, at ~pub_clock_frequency [Hz sim]
   ~model_states (gazebo_msgs/ModelStates), ~link_states (gazebo_msgs/LinkStates) at
-            ~model_states_rate [Hz sim], built only while someone listens (state_topics.py)
+            ~model_states_rate [Hz sim], built only while someone listens (state_topics.py);
+            faster than real time at most max(~watch_rate, that rate) per wall second
+            (watch_rate.py), as joint_states
   ~contacts (gazebo_msgs/ContactsState) only with ~contacts true (the stand-in's own, not
             Gazebo's): the (robot, model) pairs touching, the ground excluded, each time
             that set changes (an empty list when the last touch ends)
   per robot, what its parts' bindings publish (bindings.py): the laser's topicName
   (sensor_msgs/LaserScan) at the sensor's update_rate, the diff drive's odometryTopic
   (nav_msgs/Odometry) and TF odometryFrame -> robotBaseFrame at its updateRate (/tf is
-  advertised once a robot's drive needs it: an empty world has none, as Gazebo).
+  advertised once a robot's drive needs it: an empty world has none, as Gazebo), and the
+  joint states (joint_states, sensor_msgs/JointState). /clock, scans, odometry and /tf are
+  written in the loop's thread (direct_publisher.py) and never limited in wall time.
 Topics in: per robot, the diff drive's commandTopic (geometry_msgs/Twist); Gazebo's
 ~set_model_state and ~set_link_state (state_services.py). Not /clock: the node is its
 source (see nodes/gazebo_world).
@@ -37,6 +41,7 @@ from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
 from pybullet_gazebo.ros.state_topics import StateTopics
+from pybullet_gazebo.ros.watch_rate import topic_limit
 
 
 class SimulatorNode:
@@ -73,7 +78,7 @@ class SimulatorNode:
         self._running = False                     # run() is stepping
         self._tf_publisher = None
         self._binding_context = BindingContext(self._tf, self.lockstep.command_arrived,
-                                               debug=params.debug)
+                                               debug=params.debug, watch_rate=params.watch_rate)
         self._last_touching = []
         # publication periods in whole physics steps, so they never drift
         self._clock_every = self._steps_per_period(params.pub_clock_frequency)
@@ -81,7 +86,8 @@ class SimulatorNode:
         self._model_states_every = self._steps_per_period(params.model_states_rate)
 
         self.clock_pub = DirectPublisher("/clock", Clock) if params.use_sim_time else None
-        self.state_topics = StateTopics(self.world)
+        self.state_topics = StateTopics(self.world, topic_limit(params.watch_rate,
+                                                                params.model_states_rate))
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100,
                                             latch=True) if params.contacts else None
         self.services = GazeboServices(self)
@@ -92,6 +98,11 @@ class SimulatorNode:
                       "the world file's" if params.real_time_factor is None else
                       "~real_time_factor; the world file says %g" % world_rtf,
                       ", paused" if self.paused else "")
+        rospy.loginfo("watching topics (model_states, link_states, joint_states): %s",
+                      "at most max(%g, own rate) messages per wall second each when the "
+                      "simulation runs faster than real time (~watch_rate; 0 = no limit)"
+                      % params.watch_rate if params.watch_rate > 0 else
+                      "at their sim-time rate whatever the speed (~watch_rate 0)")
         rospy.loginfo("diff drive: %s", "Kinetic's with legacyMode true (legacy_mode:=true): "
                       "leftJoint gets v + w*sep/2; m2wr turns counter-clockwise for a positive "
                       "angular.z" if params.legacy_mode else "Noetic's, as Gazebo (legacy_mode:="
@@ -103,7 +114,7 @@ class SimulatorNode:
 
     def _tf(self):
         if self._tf_publisher is None:
-            self._tf_publisher = rospy.Publisher("/tf", TFMessage, queue_size=100)
+            self._tf_publisher = DirectPublisher("/tf", TFMessage)
         return self._tf_publisher
 
     # --- the Simulation interface the services use --------------------------------------

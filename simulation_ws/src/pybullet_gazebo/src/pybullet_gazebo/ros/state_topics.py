@@ -5,13 +5,16 @@ Published when the simulator node says they are due (its ~model_states_rate [Hz 
 built only while someone listens: for 32 models at 50 Hz, building ModelStates from scratch
 halved the loop's speed (issue 16). A static model's entry is computed once (it moves only when
 a service teleports it, which `World.layout_version` counts); the message objects are reused
-(rospy serializes a message inside publish()).
+(rospy serializes a message once inside publish(), for every subscriber). Both are watching
+topics (watch_rate.py): faster than real time, at most max(~watch_rate, model_states_rate)
+messages per wall second each. Written in the loop's thread (direct_publisher.py).
 """
-import rospy
 from geometry_msgs.msg import Pose as PoseMsg, Twist
 from gazebo_msgs.msg import LinkStates, ModelStates
 
 from pybullet_gazebo.engine import model_access
+from pybullet_gazebo.ros.direct_publisher import DirectPublisher
+from pybullet_gazebo.ros.watch_rate import WallRateLimit
 
 
 def _write(msg, index, state):
@@ -28,14 +31,18 @@ def _write(msg, index, state):
 class _StatesMessage:
     """One reusable ModelStates or LinkStates message and the rows that move."""
 
-    def __init__(self, msg_class, topic):
-        self.publisher = rospy.Publisher(topic, msg_class, queue_size=1)
+    def __init__(self, msg_class, topic, wall_limit):
+        self.publisher = DirectPublisher(topic, msg_class)
+        self.limit = WallRateLimit(wall_limit)
         self.msg = msg_class()
         self._key = None
         self._moving = []              # (row, function giving its (pose, linear, angular))
 
     def publish(self, key, rows):
-        """rows() -> [(name, static, state function)], called only when `key` changed."""
+        """rows() -> [(name, static, state function)], called only when `key` changed.
+        Nothing while no one listens, or when the wall-time limit says skip."""
+        if not (self.heard() and self.limit.allow()):
+            return
         if self._key != key:
             self._rebuild(rows())
             self._key = key
@@ -60,10 +67,12 @@ class _StatesMessage:
 
 
 class StateTopics:
-    def __init__(self, world):
+    def __init__(self, world, wall_limit=0.0):
+        """`wall_limit` [Hz wall]: at most this many messages per wall second on each topic
+        (0: no limit); see watch_rate.topic_limit."""
         self.world = world
-        self.model_states = _StatesMessage(ModelStates, "~model_states")
-        self.link_states = _StatesMessage(LinkStates, "~link_states")
+        self.model_states = _StatesMessage(ModelStates, "~model_states", wall_limit)
+        self.link_states = _StatesMessage(LinkStates, "~link_states", wall_limit)
 
     def heard(self):
         return self.model_states.heard() or self.link_states.heard()
@@ -72,10 +81,8 @@ class StateTopics:
         """Publishes the topics someone listens to. Call with the world's lock held."""
         world = self.world
         key = (world.layout_version, tuple(world.model_names()))
-        if self.model_states.heard():
-            self.model_states.publish(key, self._model_rows)
-        if self.link_states.heard():
-            self.link_states.publish(key, self._link_rows)
+        self.model_states.publish(key, self._model_rows)
+        self.link_states.publish(key, self._link_rows)
 
     def _model_rows(self):
         world = self.world
@@ -94,6 +101,10 @@ class StateTopics:
                 rows.append((ref.scoped, static,
                              lambda ref=ref: model_access.link_state(world, ref)))
         return rows
+
+    def skipped(self):
+        """Messages left out by the wall-time limit so far."""
+        return self.model_states.limit.skipped + self.link_states.limit.skipped
 
     def close(self):
         self.model_states.publisher.unregister()

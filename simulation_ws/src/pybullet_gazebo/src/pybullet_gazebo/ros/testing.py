@@ -1,6 +1,9 @@
 """Helpers for the rostest suites: waiting for messages and services with explicit time-outs,
 reading sim time and model poses, collecting a node's /rosout lines (NodeLog) and the
-simulator's touches from /gazebo/contacts (ContactLog). Used by test nodes only."""
+simulator's touches from /gazebo/contacts (ContactLog), an Xvfb server for tests of windows
+(VirtualDisplay). Used by test nodes only."""
+import os
+import subprocess
 import threading
 import time
 
@@ -133,3 +136,30 @@ class ContactLog:
             self._touches.append((msg.header.stamp.to_sec(),
                                   ["%s touches %s" % (s.collision1_name, s.collision2_name)
                                    for s in msg.states]))
+
+
+class VirtualDisplay:
+    """An Xvfb server on a free display number (Xvfb picks it: -displayfd), stopped by PID."""
+
+    def __init__(self):
+        read_end, write_end = os.pipe()
+        self.process = subprocess.Popen(
+            ["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24",
+             "-nolisten", "tcp"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL, start_new_session=True)
+        os.close(write_end)
+        with os.fdopen(read_end) as pipe:
+            number = pipe.readline().strip()       # written once the server accepts clients
+        if not number:
+            self.stop()
+            raise AssertionError("Xvfb did not start")
+        self.display = ":" + number
+
+    def stop(self):
+        if self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(10)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
