@@ -36,6 +36,9 @@ APT_PACKAGES=(
   ros-trajectory-msgs libtrajectory-msgs-dev python3-trajectory-msgs python3-dynamic-reconfigure
   # a real window for the GUI's tests on a machine with no display (Xvfb)
   xvfb
+  # rviz on m2wr (m2wr_description's rviz.launch, launch_world.launch rviz:=true), and its
+  # Python bindings, through which the rviz rostest reads the Displays panel (RobotModel OK)
+  rviz python3-rviz
 )
 
 STEP="check machine"
