@@ -73,6 +73,8 @@ def report(figures):
                                            for n in names]),
         ("  controller CPU per sim s [ms]", [fmt(loops[n]["cpu_ms_per_sim_s"]["controller"], "%.0f")
                                             for n in names]),
+        ("  listeners' CPU per sim s [ms]", [fmt(loops[n]["cpu_ms_per_sim_s"].get("listeners"),
+                                                 "%.0f") for n in names]),
         ("robot touched a model (times)", [str(loops[n]["robot_touches"]) for n in names]),
         ("scans published in the check window", [str(loops[n]["check"]["scans_published"])
                                                  for n in names]),

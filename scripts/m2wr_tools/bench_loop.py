@@ -141,6 +141,11 @@ def start_watchers(session):
     time.sleep(3.0)                      # they connect while physics is paused
 
 
+def watchers_cpu(pids):
+    """CPU seconds the listener processes have used together (0 without listeners)."""
+    return sum(processes.cpu_seconds(pid) or 0.0 for pid in pids)
+
+
 def stop_loop(session):
     session.stop([n for n in WATCHERS if n in session.children]
                  + ["controller", "spawn", "world"])
@@ -158,11 +163,14 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         call_empty(UNPAUSE_SERVICE)
         time.sleep(warmup)
         session.check_running(["world", "controller"])
+        watcher_pids = [session.children[n].pid for n in WATCHERS] if watchers else []
         sim0, wall0, touches0 = listener.wait_sim(), time.monotonic(), listener.touches
-        cpu0 = (processes.cpu_seconds(sim_pid), processes.cpu_seconds(ctrl_pid))
+        cpu0 = (processes.cpu_seconds(sim_pid), processes.cpu_seconds(ctrl_pid),
+                watchers_cpu(watcher_pids))
         time.sleep(seconds)
         sim1, wall1, touches1 = listener.wait_sim(), time.monotonic(), listener.touches
-        cpu1 = (processes.cpu_seconds(sim_pid), processes.cpu_seconds(ctrl_pid))
+        cpu1 = (processes.cpu_seconds(sim_pid), processes.cpu_seconds(ctrl_pid),
+                watchers_cpu(watcher_pids))
         session.check_running(["world", "controller"])
         sim_s, wall_s = sim1 - sim0, wall1 - wall0
         # the scan/answer count: a window that starts and ends paused, with the counters
@@ -191,7 +199,9 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         "robot_touches": touches1 - touches0,
         "cpu_ms_per_sim_s": {
             "simulator": 1e3 * (cpu1[0] - cpu0[0]) / sim_s if sim_s > 0 else None,
-            "controller": 1e3 * (cpu1[1] - cpu0[1]) / sim_s if sim_s > 0 else None},
+            "controller": 1e3 * (cpu1[1] - cpu0[1]) / sim_s if sim_s > 0 else None,
+            "listeners": 1e3 * (cpu1[2] - cpu0[2]) / sim_s if sim_s > 0 and watchers
+            else None},
         "check": {"scans_published": scans + missing, "scans_heard": scans,
                   "handled_by_controller": handled, "cmd_vel_answers": answers,
                   "missing_scans": missing,
