@@ -5,11 +5,17 @@ launch_world.launch` paused, headless, real_time_factor 0, lockstep) and a rospy
 (/m2wr_batch) in the worker process. Every run takes the same path, so that its result
 depends only on its scenario:
 
-  stop the previous run's controller -> /gazebo/reset_simulation (sim time 0, every model
-  at its initial pose, the laser's noise generator re-seeded) -> /gazebo/set_model_state
-  m2wr at the start (z 0.5 m, at rest, as spawn.launch drops it) -> the recorder connected
-  -> the controller started and publishing cmd_vel -> physics unpaused for `duration` s of
-  sim time -> paused -> controller stopped -> metrics.
+  /gazebo/reset_simulation (sim time 0, every model at its initial pose, the laser's noise
+  generator re-seeded, the drive's command and lockstep's awaited answer forgotten) ->
+  /gazebo/set_model_state m2wr at the start (z 0.5 m, at rest, as spawn.launch drops it) ->
+  the recorder restarted (one per rig: its connections stay up) -> the controller started
+  (a Python script is forked from the session's warm zygote, m2wr_tools.zygote; anything
+  else is a plain process) and publishing cmd_vel -> physics unpaused for `duration` s of
+  sim time -> paused -> the controller sent SIGINT while the run is measured -> its exit
+  awaited (the next run's reset comes after it: none of its commands can reach that run).
+
+Per-run `stages` [s wall] in the record: reset_s, controller_start_s, sim_s, measure_s,
+stop_s; `overhead_s` = the run's wall time less sim_s's unpaused part.
 
 The simulator is kept between runs of the same world and seed (reuse) and relaunched
 otherwise (the seed is a launch argument), or before every run with reuse off. The world and
@@ -199,6 +205,8 @@ class Rig:
         record["worker_rss_mib"] = (processes.rss_kib(os.getpid()) or 0) / 1024.0
         sim_rss = processes.rss_kib(self.simulator_pid) if self.simulator_pid else None
         record["simulator_rss_mib"] = sim_rss / 1024.0 if sim_rss else None
+        zygote_rss = processes.rss_kib(self.zygote.process.pid) if self.zygote else None
+        record["zygote_rss_mib"] = zygote_rss / 1024.0 if zygote_rss else None
         for name in ("success", "reason"):
             record.setdefault(name, False if name == "success" else "")
         return record

@@ -88,6 +88,7 @@ class Zygote:
 
     def __init__(self, env, log_path):
         ours, theirs = socket.socketpair()
+        ours.settimeout(None)            # blocking, whatever socket's default timeout is
         self._socket = ours
         self._reader = ours.makefile("r", encoding="utf-8")
         self._lock = threading.Lock()            # one request at a time
@@ -109,7 +110,13 @@ class Zygote:
         return self.process.running()
 
     def _listen(self):
-        for line in self._reader:
+        while True:
+            try:
+                line = self._reader.readline()
+            except (OSError, ValueError):     # closed
+                line = ""
+            if not line:
+                break
             try:
                 message = json.loads(line)
             except ValueError:
