@@ -468,12 +468,13 @@ class Rig:
                     rospy.signal_shutdown("batch worker closing")
             except ImportError:
                 pass
-            # quick: a closing Dask worker may be killed a few seconds later
-            children = list(self.session.children.values())
-            processes.stop(children, sigint_timeout=3.0, sigterm_timeout=2.0)
+            # quick: a closing Dask worker may be killed a few seconds later. The zygote
+            # first (idle: it ends at once), then the rest together.
             if self.zygote is not None:
                 self.zygote.close()
                 self.zygote = None
+            children = list(self.session.children.values())
+            processes.stop(children, sigint_timeout=3.0, sigterm_timeout=2.0)
             if self.session.master_uri:
                 processes.kill_leftovers(self.session.master_uri)
             self.session = None

@@ -178,7 +178,9 @@ class Zygote:
             self._socket.shutdown(socket.SHUT_RDWR)
         except OSError:
             pass
-        processes.stop([self.process], sigint_timeout=2.0, sigterm_timeout=2.0)
+        if self.process.wait(1.0) is None:       # the end of its input ends it
+            processes.stop([self.process], sigint_timeout=0.0, sigterm_timeout=2.0)
+        self.process.close()
         self._socket.close()
 
 
