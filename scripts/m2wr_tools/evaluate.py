@@ -6,6 +6,7 @@
                       [--seeds 0 ...] [--duration 60] [--workers N | --scheduler tcp://H:P]
                       [--output output/evaluate] [--no-reuse] [--bag] [--pictures] [--fresh]
   scripts/evaluate.sh --bench [--bench-runs 20] [--duration 60]
+  scripts/evaluate.sh --bench-memory [--bench-runs 200] [--duration 5]
 
 Runs every combination of world x start x seed (lockstep, headless, as fast as the machine
 allows; see m2wr_tools.rig for what one run does), then writes <output>/results.json and
@@ -21,8 +22,17 @@ world file's geometry at scan height). Default: the tutorial's (0, 8, 0).
 
 --bench: the same --bench-runs runs (random free starts in world02, the tutorial's
 obstacle_avoidance.py, --duration s each) with 1 and 2 workers, each with and without
-simulator reuse; prints runs/min, the speed-up, the per-run overhead with reuse and the
-memory of the workers and simulators over the runs (figures printed, not asserted).
+simulator reuse; prints runs/min, the speed-up, the per-run overhead with reuse (median
+share of a run's wall time, and its stages) and the memory of the workers and simulators
+over the runs (figures printed, not asserted).
+
+--bench-memory: --bench-runs runs (default 200) of --duration s (default 5) on one worker
+with reuse; prints the resident memory of the worker, its simulator and its controller
+zygote at runs 1, 50, 100, 150, 200 and the slope [MiB per 100 runs] after run 20.
+
+Python controllers are forked from a warm process (m2wr_tools.zygote: rospy already
+imported; the script itself still starts afresh each run); --cold-start starts them as
+plain processes.
 
 Exit status: 0 when the batch finished (failed runs included); 1 when it could not run;
 2 for bad arguments; 130 when interrupted.
@@ -71,8 +81,8 @@ def parse_args(argv):
                         "(default %g)" % FREE_MARGIN)
     parser.add_argument("--seeds", type=int, nargs="+", default=[0],
                         help="simulator seeds (laser noise), one run each (default 0)")
-    parser.add_argument("--duration", type=float, default=60.0,
-                        help="sim time of a run [s] (default 60)")
+    parser.add_argument("--duration", type=float, default=None,
+                        help="sim time of a run [s] (default 60; 5 with --bench-memory)")
     parser.add_argument("--workers", type=int, help="LocalCluster workers (default: cores)")
     parser.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. "
                         "tcp://127.0.0.1:8786 (its workers need this project set up, "
@@ -92,8 +102,20 @@ def parse_args(argv):
                         help="wall seconds a run may take (default 60 + 2 x duration)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--bench", action="store_true", help="the batch benchmark (above)")
-    parser.add_argument("--bench-runs", type=int, default=20, help="runs of the benchmark (20)")
+    parser.add_argument("--bench-memory", action="store_true",
+                        help="the memory benchmark (above)")
+    parser.add_argument("--bench-runs", type=int, default=None,
+                        help="runs of the benchmark (20; 200 with --bench-memory)")
+    parser.add_argument("--cold-start", action="store_true",
+                        help="start Python controllers as plain processes, not from the "
+                        "warm zygote")
     args = parser.parse_args(argv)
+    if args.duration is None:
+        args.duration = 5.0 if args.bench_memory else 60.0
+    if args.bench_runs is None:
+        args.bench_runs = 200 if args.bench_memory else 20
+    if args.bench_runs < 1:
+        parser.error("--bench-runs must be >= 1")
     if not (math.isfinite(args.duration) and args.duration > 0):
         parser.error("--duration must be > 0 seconds of sim time")
     if args.workers is not None and args.workers < 1:
@@ -199,8 +221,10 @@ def bench(args):
         out = os.path.join(args.output, "bench", "w%d_%s" % (workers, "reuse" if reuse else "relaunch"))
         say("bench: %s, %d runs of %g s" % (name, len(scenarios), args.duration))
         t = time.monotonic()
-        records = run_batch(scenarios, RunOptions(output=out, reuse=reuse), workers=workers,
-                            resume=False, progress=not args.no_progress, say=say)
+        records = run_batch(scenarios, RunOptions(output=out, reuse=reuse,
+                                                  warm_start=not args.cold_start),
+                            workers=workers, resume=False, progress=not args.no_progress,
+                            say=say)
         wall = time.monotonic() - t
         overheads = [r["overhead_s"] / r["wall_time_s"] for r in records
                      if r.get("overhead_s") is not None and r.get("reused")]
@@ -211,17 +235,23 @@ def bench(args):
                          "overhead_s_median": statistics.median(
                              [r["overhead_s"] for r in records if r.get("overhead_s") is not None
                               and r.get("reused")] or [math.nan]),
+                         "stages_median": _stage_medians(records),
                          "memory": _memory(records)}
         say("  %.2f runs/min" % figures[name]["runs_per_min"])
-    print("\nbatch benchmark: %d runs of %g s sim (world02, obstacle_avoidance.py, lockstep), "
-          "%d cores, load %.2f" % (len(scenarios), args.duration, os.cpu_count(),
-                                   os.getloadavg()[0]))
+    print("\nbatch benchmark: %d runs of %g s sim (world02, obstacle_avoidance.py, lockstep, "
+          "%s start), %d cores, load average %s" % (
+              len(scenarios), args.duration, "cold" if args.cold_start else "warm",
+              os.cpu_count(), " ".join("%.2f" % x for x in os.getloadavg())))
     for name, f in figures.items():
         overhead = "" if f["overhead_share_median"] is None else \
             "  overhead with reuse %.2f s = %.0f %% of a run (median)" % (
                 f["overhead_s_median"], 100 * f["overhead_share_median"])
         print("  %-22s %6.2f runs/min  (%.0f s wall, %d failed)%s" % (
             name, f["runs_per_min"], f["wall_s"], f["failed"], overhead))
+    for name, f in figures.items():
+        if f["stages_median"] and "reuse" in name:
+            print("  stages %-22s %s (median s; overhead = all but sim)" % (name, "  ".join(
+                "%s %.3f" % (k[:-2], v) for k, v in f["stages_median"].items())))
     for mode in ("reuse", "relaunch"):
         one, two = figures["1 worker, %s" % mode], figures["2 workers, %s" % mode]
         print("  speed-up 2 vs 1 worker, %-8s %.2fx" % (mode, two["runs_per_min"] / one["runs_per_min"]))
@@ -234,6 +264,74 @@ def bench(args):
         json.dump(figures, out, indent=1)
     say("figures written to %s" % path)
     return 0
+
+
+def _stage_medians(records):
+    """{stage: median [s]} over the runs that reused their simulator."""
+    stages = [r["stages"] for r in records if r.get("reused") and r.get("stages")]
+    names = [n for n in ("reset_s", "controller_start_s", "sim_s", "measure_s", "stop_s")
+             if any(n in s for s in stages)]
+    return {n: statistics.median([s[n] for s in stages if n in s]) for n in names}
+
+
+def bench_memory(args):
+    """Resident memory of one worker, its simulator and zygote over many short runs."""
+    from .batch import run_batch
+    outlines_of = _Outlines()
+    args.world, args.random, args.start, args.grid = [DEFAULT_WORLD], args.bench_runs, None, None
+    scenarios = build_scenarios(args, outlines_of)
+    out = os.path.join(args.output, "bench_memory")
+    say("memory bench: %d runs of %g s on 1 worker with reuse" % (len(scenarios), args.duration))
+    t = time.monotonic()
+    records = run_batch(scenarios, RunOptions(output=out, reuse=True,
+                                              warm_start=not args.cold_start),
+                        workers=1, resume=False, progress=not args.no_progress, say=say)
+    wall = time.monotonic() - t
+    runs = sorted(records, key=lambda r: r.get("finished_at", 0))
+    table = memory_table(runs)
+    print("\nmemory benchmark: %d runs of %g s sim on 1 worker with reuse (%s start), "
+          "%.0f s wall, %d failed, load average %s" % (
+              len(runs), args.duration, "cold" if args.cold_start else "warm", wall,
+              sum(1 for r in runs if not r.get("success")),
+              " ".join("%.2f" % x for x in os.getloadavg())))
+    print(table["text"])
+    path = os.path.join(out, "memory.json")
+    with open(path, "w") as dump:
+        json.dump({k: v for k, v in table.items() if k != "text"}, dump, indent=1)
+    say("figures written to %s" % path)
+    return 0
+
+
+MEMORY_KEYS = (("worker", "worker_rss_mib"), ("simulator", "simulator_rss_mib"),
+               ("zygote", "zygote_rss_mib"))
+
+
+def memory_table(runs, marks=(1, 50, 100, 150, 200), warm_up=20):
+    """The RSS [MiB] of each process at the run numbers `marks` (1-based, in finishing
+    order) and its least-squares slope [MiB per 100 runs] over the runs after `warm_up`."""
+    import numpy as np
+    marks = [m for m in marks if m <= len(runs)] or [len(runs)]
+    if marks[-1] != len(runs):
+        marks.append(len(runs))
+    lines = ["  %-10s %s   slope after run %d" % ("RSS MiB", "".join(
+        "%9s" % ("run %d" % m) for m in marks), warm_up)]
+    data = {"marks": marks, "slopes_mib_per_100_runs": {}, "rss_mib": {}}
+    for label, key in MEMORY_KEYS:
+        values = [r.get(key) for r in runs]
+        if not any(values):
+            continue
+        at = ["%9s" % ("%.1f" % values[m - 1] if values[m - 1] else "n/a") for m in marks]
+        points = [(i, v) for i, v in enumerate(values) if v and i >= warm_up]
+        slope = None
+        if len(points) >= 2:
+            x, y = np.array(points, dtype=float).T
+            slope = float(np.polyfit(x, y, 1)[0]) * 100.0
+        data["slopes_mib_per_100_runs"][label] = slope
+        data["rss_mib"][label] = values
+        lines.append("  %-10s %s   %s" % (label, "".join(at), "n/a" if slope is None
+                                           else "%+.2f MiB per 100 runs" % slope))
+    data["text"] = "\n".join(lines)
+    return data
 
 
 def _memory(records):
@@ -258,6 +356,8 @@ def main(argv=None):
         os.makedirs(args.output, exist_ok=True)
         if args.bench:
             return bench(args)
+        if args.bench_memory:
+            return bench_memory(args)
         outlines_of = _Outlines()
         try:
             scenarios = build_scenarios(args, outlines_of)
@@ -269,7 +369,7 @@ def main(argv=None):
             len(args.seeds), args.duration))
         options = RunOptions(output=args.output, reuse=not args.no_reuse, bag=args.bag,
                              picture=args.pictures, connect_timeout=args.connect_timeout,
-                             run_timeout=args.run_timeout)
+                             run_timeout=args.run_timeout, warm_start=not args.cold_start)
         records = run_batch(scenarios, options, scheduler=args.scheduler, workers=args.workers,
                             resume=not args.fresh, progress=not args.no_progress, say=say)
         report(args, records, outlines_of, scenarios)

@@ -43,3 +43,51 @@ def set_model_pose(name, x, y, z, yaw, timeout=10.0):
     answer = rospy.ServiceProxy(SET_MODEL_STATE_SERVICE, SetModelState)(state)
     if not answer.success:
         raise RuntimeError("set_model_state(%s) failed: %s" % (name, answer.status_message))
+
+
+class Services:
+    """The simulator's pause/unpause/reset and set_model_state over persistent connections
+    (a fresh proxy costs a master lookup and a TCP handshake per call; the batch makes
+    five calls a run). A broken connection (the simulator was relaunched) is opened again
+    once per call, after waiting up to `timeout` [s] for the service."""
+
+    def __init__(self, timeout=10.0):
+        self.timeout = timeout
+        self._proxies = {}
+
+    def _call(self, name, kind, *args):
+        import rospy
+        for attempt in (0, 1):
+            proxy = self._proxies.get(name)
+            if proxy is None:
+                rospy.wait_for_service(name, timeout=self.timeout)
+                proxy = self._proxies[name] = rospy.ServiceProxy(name, kind, persistent=True)
+            try:
+                return proxy(*args)
+            except (rospy.ServiceException, rospy.exceptions.TransportException, OSError):
+                self.close(name)
+                if attempt:
+                    raise
+
+    def empty(self, name):
+        from std_srvs.srv import Empty
+        self._call(name, Empty)
+
+    def set_model_pose(self, name, x, y, z, yaw):
+        """As set_model_pose() above."""
+        from gazebo_msgs.msg import ModelState
+        from gazebo_msgs.srv import SetModelState
+        from pybullet_gazebo.engine.transforms import quaternion_from_rpy
+        state = ModelState(model_name=name, reference_frame="world")
+        state.pose.position.x, state.pose.position.y, state.pose.position.z = x, y, z
+        o = state.pose.orientation
+        o.x, o.y, o.z, o.w = quaternion_from_rpy(0.0, 0.0, yaw)
+        answer = self._call(SET_MODEL_STATE_SERVICE, SetModelState, state)
+        if not answer.success:
+            raise RuntimeError("set_model_state(%s) failed: %s" % (name, answer.status_message))
+
+    def close(self, name=None):
+        for key in [name] if name else list(self._proxies):
+            proxy = self._proxies.pop(key, None)
+            if proxy is not None:
+                proxy.close()

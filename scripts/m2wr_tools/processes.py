@@ -30,7 +30,7 @@ def port_in_use(port, host="127.0.0.1"):
 class Child:
     """A command started in a new session (its own process group), output to a log file."""
 
-    def __init__(self, name, argv, env, log_path):
+    def __init__(self, name, argv, env, log_path, pass_fds=()):
         self.name = name
         self.argv = list(argv)
         self.log_path = log_path
@@ -39,7 +39,7 @@ class Child:
         try:
             self.popen = subprocess.Popen(self.argv, env=env, stdout=self._log,
                                           stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                          start_new_session=True)
+                                          start_new_session=True, pass_fds=tuple(pass_fds))
         except OSError as err:
             self._log.close()
             raise RuntimeError("cannot start %s (%s): %s" % (name, " ".join(self.argv), err))
@@ -140,6 +140,11 @@ def tagged(name, value, exclude=()):
         if environment_of(pid).get(name) == value and not _zombie(pid):
             found.append(pid)
     return sorted(found)
+
+
+def alive(pid):
+    """True while `pid` is a live process (not a zombie)."""
+    return os.path.exists("/proc/%d" % pid) and not _zombie(pid)
 
 
 def _zombie(pid):

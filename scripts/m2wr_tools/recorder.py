@@ -59,6 +59,18 @@ class Recorder:
             sub(rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self.on_contacts,
                                  queue_size=100))
 
+    def restart(self):
+        """Forgets everything heard so far (a new run after a reset), keeping the
+        subscriptions, whose connections are up already; the scans stop until fire_at's
+        window again."""
+        if self._scan_sub is not None:
+            self._scan_sub.unregister()
+            self._scan_sub = None
+        self._target = None
+        self.reached.clear()
+        self.sim_time, self.last_scan, self.scans = None, None, 0
+        self.poses, self.cases, self.contacts = [], [], []
+
     def unregister(self):
         for subscriber in self._subscribers + ([self._scan_sub] if self._scan_sub else []):
             subscriber.unregister()

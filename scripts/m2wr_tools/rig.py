@@ -5,11 +5,17 @@ launch_world.launch` paused, headless, real_time_factor 0, lockstep) and a rospy
 (/m2wr_batch) in the worker process. Every run takes the same path, so that its result
 depends only on its scenario:
 
-  stop the previous run's controller -> /gazebo/reset_simulation (sim time 0, every model
-  at its initial pose, the laser's noise generator re-seeded) -> /gazebo/set_model_state
-  m2wr at the start (z 0.5 m, at rest, as spawn.launch drops it) -> the recorder connected
-  -> the controller started and publishing cmd_vel -> physics unpaused for `duration` s of
-  sim time -> paused -> controller stopped -> metrics.
+  /gazebo/reset_simulation (sim time 0, every model at its initial pose, the laser's noise
+  generator re-seeded, the drive's command and lockstep's awaited answer forgotten) ->
+  /gazebo/set_model_state m2wr at the start (z 0.5 m, at rest, as spawn.launch drops it) ->
+  the recorder restarted (one per rig: its connections stay up) -> the controller started
+  (a Python script is forked from the session's warm zygote, m2wr_tools.zygote; anything
+  else is a plain process) and publishing cmd_vel -> physics unpaused for `duration` s of
+  sim time -> paused -> the controller sent SIGINT while the run is measured -> its exit
+  awaited (the next run's reset comes after it: none of its commands can reach that run).
+
+Per-run `stages` [s wall] in the record: reset_s, controller_start_s, sim_s, measure_s,
+stop_s; `overhead_s` = the run's wall time less sim_s's unpaused part.
 
 The simulator is kept between runs of the same world and seed (reuse) and relaunched
 otherwise (the seed is a launch argument), or before every run with reuse off. The world and
@@ -40,7 +46,7 @@ import time
 import numpy as np
 
 from . import metrics, processes
-from .gazebo import call_empty, model_poses, set_model_pose
+from .gazebo import Services, model_poses
 from .names import (BASE_FRAME, COMMAND_TOPIC, CONTACTS_TOPIC, ODOM_TOPIC, PAUSE_SERVICE,
                     RESET_SIMULATION_SERVICE, ROBOT, SCAN_TOPIC, SIMULATOR_NODE, TF_TOPIC,
                     UNPAUSE_SERVICE)
@@ -51,6 +57,8 @@ NODE = "/m2wr_batch"
 SPAWN_Z = 0.5                 # [m] spawn.launch's default drop height of link_chassis
 PATH_PERIOD = 0.5             # [s] sim: the path kept in the results
 CLEARANCE_PERIOD = 0.1        # [s] sim: poses whose clearance is measured
+LAST_MESSAGES = 0.2           # [s] wall after the pause by which the run's last messages
+                              # (contacts, cmd_vel) have arrived; the track is measured meanwhile
 BATCH_TAG = "M2WR_BATCH"      # environment variable naming the batch every child belongs to
 
 
@@ -67,6 +75,7 @@ class RunOptions:
     bag: bool = False                 # rosbag per run: runs/<run_id>.bag
     picture: bool = False             # the demo's picture per run: runs/<run_id>.png
     batch: str = ""                   # the batch's tag (BATCH_TAG in every child's environment)
+    warm_start: bool = True           # fork Python controllers from a warm zygote (m2wr_tools.zygote)
 
 
 class RunFailed(Exception):
@@ -82,6 +91,8 @@ class Rig:
         self.commands = 0
         self._command_sub = None
         self.scenes = {}              # world -> scene.Scene (offline geometry)
+        self.zygote = None            # zygote.Zygote of this session (warm Python controllers)
+        self.services = Services()    # the simulator's services, connections kept between runs
         self._executables = {}        # (package, name) -> path, for rosrun command lines
         self.worker = "%s:%d" % (socket.gethostname(), os.getpid())
 
@@ -118,6 +129,7 @@ class Rig:
         if options.reuse and self.key == key and world is not None and world.running():
             return True
         self.session.stop(["controller", "rosbag", "spawn", "world"])
+        self.services.close()
         self.key = None
         self.session.launch_world(scenario.world, real_time_factor=0.0, lockstep=options.lockstep,
                                   seed=scenario.seed, paused=True,
@@ -180,7 +192,10 @@ class Rig:
             record.update(success=False, reason="%s: %s" % (type(err).__name__, err))
             self.key = None
         finally:
+            stopping = time.monotonic()
             record["controller_exit"] = self._stop_controller(record.get("controller_exit"))
+            if isinstance(record.get("stages"), dict):
+                record["stages"]["stop_s"] = round(time.monotonic() - stopping, 3)
         record["wall_time_s"] = time.monotonic() - wall0
         record["finished_at"] = time.time()
         sim = record.get("sim_time_s") or 0.0
@@ -190,6 +205,8 @@ class Rig:
         record["worker_rss_mib"] = (processes.rss_kib(os.getpid()) or 0) / 1024.0
         sim_rss = processes.rss_kib(self.simulator_pid) if self.simulator_pid else None
         record["simulator_rss_mib"] = sim_rss / 1024.0 if sim_rss else None
+        zygote_rss = processes.rss_kib(self.zygote.process.pid) if self.zygote else None
+        record["zygote_rss_mib"] = zygote_rss / 1024.0 if zygote_rss else None
         for name in ("success", "reason"):
             record.setdefault(name, False if name == "success" else "")
         return record
@@ -214,25 +231,27 @@ class Rig:
             now = time.monotonic()
             stages[name] = round(now - mark[0], 3)
             mark[0] = now
-        call_empty(PAUSE_SERVICE)
-        call_empty(RESET_SIMULATION_SERVICE)
-        set_model_pose(ROBOT, scenario.x, scenario.y, SPAWN_Z, scenario.yaw)
+        self.services.empty(PAUSE_SERVICE)
+        self.services.empty(RESET_SIMULATION_SERVICE)
+        self.services.set_model_pose(ROBOT, scenario.x, scenario.y, SPAWN_Z, scenario.yaw)
         task = scenario.task
         if task.kind == "goal":
             for name, value in (("des_pos_x", task.goal[0]), ("des_pos_y", task.goal[1]),
                                 ("initial_x", scenario.x), ("initial_y", scenario.y)):
                 rospy.set_param("/" + name, float(value))
-        old, recorder = self.recorder, Recorder(poses_from_tf=BASE_FRAME)
-        if old is not None:
-            old.unregister()
-        self.recorder = recorder
+        # One recorder for the rig's life: its connections stay up between runs, and a
+        # latched /gazebo/contacts message of an earlier run never reaches a new one.
+        if self.recorder is None:
+            self.recorder = Recorder(poses_from_tf=BASE_FRAME)
+        recorder = self.recorder
+        recorder.restart()
         self.commands = 0
         self._wait(lambda: session.connected(SIMULATOR_NODE, TF_TOPIC, NODE)
                    and session.connected(SIMULATOR_NODE, CONTACTS_TOPIC, NODE), 10.0,
                    "the batch's recorder did not connect to the simulator")
         stage("reset_s")
-        controller = session.start_controller(self._resolve(scenario.controller),
-                                              log_name=os.path.relpath(log_path[:-4], session.log_dir))
+        controller = self._start_controller(self._resolve(scenario.controller), log_path,
+                                            options.warm_start)
         self._wait_for_controller(controller, options.connect_timeout, log_path)
         stage("controller_start_s")
         if options.bag:
@@ -241,7 +260,7 @@ class Rig:
             time.sleep(1.0)
         limit = options.run_timeout or 60.0 + 2.0 * scenario.duration
         recorder.fire_at(scenario.duration)
-        call_empty(UNPAUSE_SERVICE)
+        self.services.empty(UNPAUSE_SERVICE)
         start = time.monotonic()
         outcome = None
         while not recorder.reached.wait(0.1):
@@ -260,22 +279,26 @@ class Rig:
                            "stalls it); see %s" % (limit, recorder.sim_time or 0.0,
                                                   scenario.duration, log_path))
                 break
-        call_empty(PAUSE_SERVICE)
-        unpaused = time.monotonic() - start
+        self.services.empty(PAUSE_SERVICE)
+        paused_at = time.monotonic()
+        unpaused = paused_at - start
         stage("sim_s")
         exit_status = None
         if not controller.running():
             exit_status = "exit %s" % controller.returncode
         else:
-            # Lockstep may be holding the loop for the answer to the last scan: once it comes,
-            # the loop takes its last step and idles. Stopping the controller before that
-            # would leave the loop waiting, and its last step would land in the next run.
-            self._wait_quiet()
+            # Physics is paused: the loop takes no step, even if lockstep was waiting for an
+            # answer (a pause ends that wait), and the next run's reset forgets the awaited
+            # answer and the drive's command; the controller may stop at once.
             controller.signal_group(signal.SIGINT)     # it ends while the run is measured
-        time.sleep(0.2)                       # the last messages arrive (physics is paused)
+
+        def settled():
+            """The messages sent before the pause have arrived (contacts, cmd_vel counts:
+            other connections than /tf's, which `reached` waited for)."""
+            time.sleep(max(0.0, paused_at + LAST_MESSAGES - time.monotonic()))
+        result = self._measure(scenario, recorder, options, runs_dir, settled)
         if outcome is None and self.commands == 0:
             outcome = "the controller never published on %s; see %s" % (COMMAND_TOPIC, log_path)
-        result = self._measure(scenario, recorder, options, runs_dir)
         stage("measure_s")
         result["stages"] = stages
         result["_unpaused_wall_s"] = unpaused
@@ -287,16 +310,28 @@ class Rig:
             self.key = None       # the loop may still wait for that controller: relaunch
         return result
 
-    def _wait_quiet(self, quiet=0.25, timeout=5.0):
-        """Until no cmd_vel has come for `quiet` [s] of wall time (at most `timeout`)."""
-        deadline = time.monotonic() + timeout
-        count, since = self.commands, time.monotonic()
-        while time.monotonic() < deadline:
-            time.sleep(0.05)
-            if self.commands != count:
-                count, since = self.commands, time.monotonic()
-            elif time.monotonic() - since >= quiet:
-                return
+    def _start_controller(self, argv, log_path, warm):
+        """The run's controller as the session's child "controller": forked from the warm
+        zygote when it is a Python script of this interpreter (see m2wr_tools.zygote), else
+        a plain subprocess (roslaunch, binaries, other interpreters)."""
+        from . import zygote
+        session = self.session
+        if warm and zygote.warm_script(argv, session.env.get("PATH", os.defpath)):
+            if self.zygote is None or not self.zygote.running():
+                if self.zygote is not None:
+                    self.zygote.close()
+                self.zygote = zygote.Zygote(session.env, os.path.join(session.log_dir,
+                                                                      "zygote.log"))
+            try:
+                child = self.zygote.start("controller", argv, session.env, log_path)
+            except RuntimeError:
+                self.zygote.close()
+                self.zygote = None               # a plain start below; a new zygote next run
+            else:
+                session.children["controller"] = child
+                return child
+        return session.start_controller(argv, log_name=os.path.relpath(log_path[:-4],
+                                                                       session.log_dir))
 
     def _wait(self, condition, timeout, what):
         deadline = time.monotonic() + timeout
@@ -306,13 +341,16 @@ class Rig:
             time.sleep(0.02)
         raise SessionError("%s within %.0f s" % (what, timeout))
 
-    def _wait_for_controller(self, controller, timeout, log_path, settle=0.3):
+    def _wait_for_controller(self, controller, timeout, log_path, settle=0.3, idle=0.1):
         """Until a node other than the batch's publishes cmd_vel to the simulator, and every
         topic of the simulator it subscribes to is connected, unchanged for `settle` [s]
-        (a program may subscribe after it advertises, as obstacle_avoidance.py does)."""
+        (a program may subscribe after it advertises, as obstacle_avoidance.py does) - or
+        for `idle` [s] during which the controller used no CPU at all, when that node is
+        the controller's own process (it has finished starting and waits for messages)."""
         master = self.session.master()
         deadline = time.monotonic() + timeout
         ready_since, last = None, None
+        own, cpu, idle_since = None, None, None
         while time.monotonic() < deadline:
             if not controller.running():
                 raise RunFailed("controller exited with status %s while starting; see %s:\n%s"
@@ -328,19 +366,29 @@ class Rig:
                             for n in names if n in nodes)
             ready = any(self.session.connected(SIMULATOR_NODE, COMMAND_TOPIC, n) for n in nodes) \
                 and all(self.session.connected(SIMULATOR_NODE, t, n) for n, t in wanted)
+            now = time.monotonic()
             if ready and wanted == last:
-                ready_since = ready_since or time.monotonic()
-                if time.monotonic() - ready_since >= settle:
+                if ready_since is None:
+                    ready_since = now
+                    own = len(nodes) == 1 and self.session.node_pid(next(iter(nodes))) \
+                        == controller.pid
+                used = processes.cpu_seconds(controller.pid) if own else None
+                if used is None or used != cpu:
+                    cpu, idle_since = used, now
+                if now - ready_since >= settle or (
+                        own and now - idle_since >= idle and now - ready_since >= idle):
                     return
             else:
-                ready_since = None
+                ready_since, own, cpu, idle_since = None, None, None, None
             last = wanted
-            time.sleep(0.05)
+            time.sleep(0.02)
         raise RunFailed("the controller published no %s within %.0f s of wall time (it is "
                         "running; see %s)" % (COMMAND_TOPIC, timeout, log_path))
 
-    def _measure(self, scenario, recorder, options, runs_dir):
-        """The run's metrics over [0, duration] of sim time."""
+    def _measure(self, scenario, recorder, options, runs_dir, settled=lambda: None):
+        """The run's metrics over [0, duration] of sim time. What needs only the track
+        (heard up to `duration` already) comes first; `settled()` returns once the other
+        topics' last messages are in."""
         from pybullet_gazebo.engine.transforms import Pose, yaw_from_quaternion
         task, duration = scenario.task, scenario.duration
         rows = [(p[0], p[1], p[2], yaw_from_quaternion(p[4:8]), *p[3:8]) for p in recorder.poses]
@@ -348,21 +396,32 @@ class Rig:
         if not len(track):
             raise RunFailed("no odometry was heard during the run")
         end = float(track[-1, 0])
-        events, touching = metrics.contact_figures(recorder.contacts, duration)
         goal_time = metrics.time_to_goal(track, task.goal, task.tolerance) \
             if task.kind == "goal" else None
         sampled = metrics.decimate(track, CLEARANCE_PERIOD)
+        poses = [Pose(tuple(r[1:3]) + (r[4],), tuple(r[5:9])) for r in sampled]
         scene = self._scene(scenario.world)
-        try:
-            if events:
-                scene.set_model_poses({n: p for n, p in model_poses().items() if n != ROBOT})
-            poses = [Pose(tuple(r[1:3]) + (r[4],), tuple(r[5:9])) for r in sampled]
+        clearances = nearest = None
+        if task.kind == "wall":
             clearances = scene.clearance(poses, max_distance=50.0)
-        finally:
-            scene.world.reset_world()
-        distances = np.array([c.distance for c in clearances])
-        nearest = clearances[int(np.argmin(distances))] if len(clearances) else None
-        wall_share = metrics.fraction_within(distances, task.wall_near, task.wall_far)
+        else:
+            nearest = scene.nearest(poses, max_distance=50.0)
+        settled()
+        events, touching = metrics.contact_figures(recorder.contacts, duration)
+        if events:      # obstacles may have been pushed: measure where the simulator left them
+            try:
+                scene.set_model_poses({n: p for n, p in model_poses().items() if n != ROBOT})
+                if task.kind == "wall":
+                    clearances = scene.clearance(poses, max_distance=50.0)
+                else:
+                    nearest = scene.nearest(poses, max_distance=50.0)
+            finally:
+                scene.world.reset_world()
+        wall_share = None
+        if clearances is not None:
+            distances = np.array([c.distance for c in clearances])
+            nearest = clearances[int(np.argmin(distances))] if len(clearances) else None
+            wall_share = metrics.fraction_within(distances, task.wall_near, task.wall_far)
         distance = metrics.distance(track[:, 1:3])
         success, reason = metrics.judge(task, distance, events, goal_time, wall_share)
         path = metrics.decimate(track, PATH_PERIOD)
@@ -373,7 +432,7 @@ class Rig:
             "min_clearance_model": nearest.model if nearest else "",
             "contact_events": events, "time_in_contact_s": touching,
             "time_stuck_s": metrics.stuck_time(track),
-            "wall_share": wall_share if task.kind == "wall" else None,
+            "wall_share": wall_share,
             "final_x": float(track[-1, 1]), "final_y": float(track[-1, 2]),
             "final_yaw": float(track[-1, 3]),
             "path": [[round(float(t), 3), round(float(x), 4), round(float(y), 4)]
@@ -401,6 +460,7 @@ class Rig:
         for scene in self.scenes.values():
             scene.close()
         self.scenes.clear()
+        self.services.close()
         if self.session is not None:
             try:
                 import rospy
@@ -408,7 +468,11 @@ class Rig:
                     rospy.signal_shutdown("batch worker closing")
             except ImportError:
                 pass
-            # quick: a closing Dask worker may be killed a few seconds later
+            # quick: a closing Dask worker may be killed a few seconds later. The zygote
+            # first (idle: it ends at once), then the rest together.
+            if self.zygote is not None:
+                self.zygote.close()
+                self.zygote = None
             children = list(self.session.children.values())
             processes.stop(children, sigint_timeout=3.0, sigterm_timeout=2.0)
             if self.session.master_uri:

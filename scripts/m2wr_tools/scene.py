@@ -9,7 +9,8 @@ how close the robot came to them.
   reports it), the smallest distance [m] between the robot's collision shapes and any
   model other than the ground (negative = penetration), with pybullet's getClosestPoints.
   The wheels' ground-contact spheres the engine adds (they touch only the ground) are left
-  out.
+  out. `nearest(poses)`: the closest pose alone, measuring only the poses that could be it
+  (a bound from the bodies' and the robot's bounding boxes prunes the rest).
 - `frame_pose(robot_pose, link)`: world pose of a robot link (e.g. the laser's frame) when
   the robot's model frame is at `robot_pose`.
 """
@@ -31,6 +32,8 @@ from .names import ROBOT
 SCAN_HEIGHT = 0.15           # [m] m2wr's laser plane above the ground, where obstacles are cut
 _PRISM_SIDES = 48            # a tilted cylinder is cut as this many-sided prism
 _FAR = 1.0e3                 # [m] the robot waits here until placed
+_BOUND_SLACK = 0.02          # [m] bounds are lowered by this much (rounding; the boxes
+                             # Bullet gives already hold its collision margins)
 
 
 @dataclass(frozen=True)
@@ -134,6 +137,7 @@ class Scene:
         self.robot = self.world.spawn_urdf(robot, urdf_xml, Pose((0.0, 0.0, _FAR)))
         self._contact_links = {index for name, index in self.robot.links.items()
                                if name.endswith(wheel_contact.SUFFIX)}
+        self._corners = None
 
     @classmethod
     def of_world(cls, world, urdf_xml=None):
@@ -210,30 +214,74 @@ class Scene:
     def clearance(self, poses: Sequence[Pose], max_distance=5.0) -> List[Clearance]:
         """Per pose, the robot's smallest distance to an obstacle [m] (see the module's
         docstring); distance inf and model "" when nothing is within max_distance [m]."""
-        client, robot_body = self.client, self.robot.body_id
+        bodies, bounds = self._bounds(poses)
+        return [self._pose_clearance(pose, index, bodies, bounds[index], max_distance)
+                for index, pose in enumerate(poses)]
+
+    def nearest(self, poses: Sequence[Pose], max_distance=5.0) -> Optional[Clearance]:
+        """The pose of `poses` where the robot came closest to an obstacle: the same answer
+        as min(clearance(poses)) by (distance, index), measured only at the poses whose
+        lower bound could beat the best found so far (most of a track is far from
+        everything). None when `poses` is empty."""
+        if not len(poses):
+            return None
+        bodies, bounds = self._bounds(poses)
+        lowest = bounds.min(axis=1) if bounds.shape[1] else np.full(len(poses), np.inf)
+        best = None
+        for index in np.lexsort((np.arange(len(poses)), lowest)):
+            if best is not None and lowest[index] > min(best.distance, max_distance):
+                break
+            found = self._pose_clearance(poses[index], int(index), bodies, bounds[index],
+                                         max_distance)
+            if best is None or (found.distance, found.index) < (best.distance, best.index):
+                best = found
+        return best
+
+    def _bounds(self, poses):
+        """(obstacle bodies [(body, model)], (poses, bodies) lower bounds [m] of the
+        robot-body distance): the gap between each body's bounding box and a box holding
+        the robot at that pose (its links' boxes at rest, turned with the pose), less
+        _BOUND_SLACK."""
+        client = self.client
         bodies = [(b, name) for name in self.obstacles() for b in self.world.entities[name].body_ids]
         boxes = np.array([np.concatenate(client.getAABB(b, -1)) for b, _ in bodies]) \
             if bodies else np.zeros((0, 6))
-        result = []
-        for index, pose in enumerate(poses):
-            self.place_robot(pose)
-            low, high = np.full(3, np.inf), np.full(3, -np.inf)
+        corners = self._robot_corners()
+        positions = np.array([p.position for p in poses], dtype=float).reshape(-1, 3)
+        rotations = np.array([rotation_matrix(p.orientation) for p in poses]).reshape(-1, 3, 3)
+        points = np.einsum("pij,cj->pci", rotations, corners) + positions[:, None, :]
+        low, high = points.min(axis=1), points.max(axis=1)               # (poses, 3)
+        gap = np.maximum(0.0, np.maximum(boxes[None, :, :3] - high[:, None, :],
+                                         low[:, None, :] - boxes[None, :, 3:]))
+        return bodies, np.sqrt((gap * gap).sum(axis=2)) - _BOUND_SLACK
+
+    def _robot_corners(self):
+        """(n, 3) corners [m] of the robot's links' bounding boxes (those whose closest
+        points count) at rest, in its model frame."""
+        if self._corners is None:
+            self.place_robot(Pose((0.0, 0.0, _FAR)))
+            corners = []
             for link in [-1] + [i for i in self.robot.links.values()
                                 if i >= 0 and i not in self._contact_links]:
-                a, b = client.getAABB(robot_body, link)
-                low, high = np.minimum(low, a), np.maximum(high, b)
-            # distance between bounding boxes: a lower bound of the true distance
-            gap = np.maximum(0.0, np.maximum(boxes[:, :3] - high, low - boxes[:, 3:]))
-            bound = np.sqrt((gap * gap).sum(axis=1))
-            best, best_model = math.inf, ""
-            for k in np.argsort(bound):
-                if bound[k] > min(best, max_distance):
-                    break
-                body, name = bodies[k]
-                for point in client.getClosestPoints(robot_body, body, distance=max_distance):
-                    if point[3] in self._contact_links:
-                        continue
-                    if point[8] < best:
-                        best, best_model = point[8], name
-            result.append(Clearance(float(best), best_model, index))
-        return result
+                low, high = self.client.getAABB(self.robot.body_id, link)
+                corners += [(x, y, z - _FAR) for x in (low[0], high[0]) for y in (low[1], high[1])
+                            for z in (low[2], high[2])]
+            self._corners = np.array(corners)
+        return self._corners
+
+    def _pose_clearance(self, pose, index, bodies, bound, max_distance):
+        """Clearance at one pose, asking Bullet only about bodies whose bound can beat the
+        best distance found so far (nearest bound first)."""
+        client, robot_body = self.client, self.robot.body_id
+        self.place_robot(pose)
+        best, best_k = math.inf, None          # a tie goes to the body listed first
+        for k in np.argsort(bound, kind="stable"):
+            if bound[k] > min(best, max_distance):
+                break
+            body, _ = bodies[k]
+            for point in client.getClosestPoints(robot_body, body, distance=max_distance):
+                if point[3] in self._contact_links:
+                    continue
+                if (point[8], k) < (best, best_k if best_k is not None else len(bodies)):
+                    best, best_k = point[8], k
+        return Clearance(float(best), bodies[best_k][1] if best_k is not None else "", index)

@@ -129,3 +129,16 @@ def test_tilted_cylinder_is_cut_as_a_polygon():
     assert max(ys) == pytest.approx(1.0) and min(ys) == pytest.approx(-1.0)
     assert max(xs) == pytest.approx(0.5, abs=1e-9)
     assert cut_cylinder((0, 0, 0.5), np.eye(3), 0.5, 0.2, 0.8, "stub") is None
+
+
+def test_nearest_is_the_closest_of_all_poses_measured_one_by_one(scene):
+    # a track that passes the wall ahead closer and closer, then turns away
+    poses = [Pose.from_xyz_rpy(x, y, 0.1, 0, 0, yaw) for x, y, yaw in
+             [(0.0, 0.0, 0.0), (1.0, 0.5, 0.3), (2.0, -0.5, -0.2), (2.4, 0.0, 1.0),
+              (1.5, 1.0, 2.0), (0.5, -1.0, 3.0)]]
+    every = scene.clearance(poses)
+    best = min(every, key=lambda c: (c.distance, c.index))
+    assert scene.nearest(poses) == best
+    assert best.index == 3 and best.model
+    assert scene.nearest(list(reversed(poses))).distance == best.distance
+    assert scene.nearest([]) is None

@@ -46,3 +46,28 @@ def test_bad_arguments_are_named(argv, message, capsys):
         evaluate.parse_args(argv)
     assert exit_info.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_the_memory_bench_defaults_to_200_short_runs():
+    args = evaluate.parse_args(["--bench-memory"])
+    assert args.bench_runs == 200 and args.duration == 5.0
+    args = evaluate.parse_args(["--bench"])
+    assert args.bench_runs == 20 and args.duration == 60.0 and not args.cold_start
+
+
+def test_the_memory_table_reports_rss_at_the_marks_and_its_slope():
+    # a worker that grows 0.05 MiB a run, a simulator that stays flat after a warm-up
+    runs = [{"worker_rss_mib": 300.0 + 0.05 * i,
+             "simulator_rss_mib": 500.0 if i >= 10 else 400.0 + 10 * i,
+             "zygote_rss_mib": None} for i in range(200)]
+    table = evaluate.memory_table(runs)
+    assert table["marks"] == [1, 50, 100, 150, 200]
+    assert abs(table["slopes_mib_per_100_runs"]["worker"] - 5.0) < 1e-6
+    assert abs(table["slopes_mib_per_100_runs"]["simulator"]) < 1e-6
+    assert "zygote" not in table["slopes_mib_per_100_runs"]
+    lines = table["text"].splitlines()
+    assert "run 1" in lines[0] and "run 200" in lines[0]
+    assert lines[1].split()[:3] == ["worker", "300.0", "302.4"]
+    assert "+5.00 MiB per 100 runs" in lines[1]
+    short = evaluate.memory_table(runs[:30])
+    assert short["marks"] == [1, 30]

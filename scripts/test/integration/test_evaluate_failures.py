@@ -32,3 +32,18 @@ def test_crashing_and_silent_controllers_fail_their_runs_not_the_batch(tmp_path,
     assert r["reason"].startswith("the controller published no /cmd_vel within 5 s"), r["reason"]
     assert os.path.exists(r["controller_log"])
     no_process_left(data)
+
+
+def test_a_hung_controller_is_failed_by_the_run_timeout(tmp_path, run_evaluate,
+                                                        no_process_left):
+    status, text, data = run_evaluate(
+        ["--controller", os.path.join(FIXTURES, "hung_controller.py"), "--workers", "1",
+         "--run-timeout", "6"], tmp_path / "hung")
+    assert status == 0, text
+    [r] = data["runs"]
+    assert r["success"] is False
+    assert r["reason"].startswith("did not finish within 6 s of wall time"), r["reason"]
+    assert r["controller_log"] in r["reason"] and os.path.exists(r["controller_log"])
+    assert r["cmd_vel_messages"] >= 1            # it did answer once
+    assert r["sim_time_s"] < 20.0                # lockstep held the simulator for it
+    no_process_left(data)
