@@ -15,7 +15,7 @@ CLOCK_TOPIC = "/clock"                     # rosgraph_msgs/Clock
 TF_TOPIC = "/tf"                           # tf2_msgs/TFMessage: odom -> link_chassis
 BASE_FRAME = "link_chassis"                # m2wr's base frame (the diff drive's robotBaseFrame)
 CONTACTS_TOPIC = "/gazebo/contacts"        # gazebo_msgs/ContactsState: what the robot touches
-ROSOUT_AGG_TOPIC = "/rosout_agg"           # rosgraph_msgs/Log, every node's log lines
+ROSOUT_TOPIC = "/rosout"                   # rosgraph_msgs/Log, each node's log lines
 
 # services (Gazebo's names and types)
 SPAWN_SERVICE = "/gazebo/spawn_urdf_model"

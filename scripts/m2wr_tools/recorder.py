@@ -8,7 +8,7 @@ Topics in:
                                              /tf's publisher drops nothing under load)
   /m2wr/laser/scan (sensor_msgs/LaserScan)   only over the run's last `scan_window` seconds
                                              of sim time: the last scan, and a count
-  /rosout_agg (rosgraph_msgs/Log)            obstacle_avoidance.py's case lines (node
+  /rosout (rosgraph_msgs/Log)                obstacle_avoidance.py's case lines (node
                                              /reading_laser): (stamp, text)
   /gazebo/contacts (gazebo_msgs/ContactsState)  each set of (robot, model) pairs in contact
 
@@ -28,7 +28,7 @@ from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
 from . import summary
-from .names import (CONTACTS_TOPIC, CONTROLLER_NODE, ODOM_TOPIC, ROSOUT_AGG_TOPIC, SCAN_TOPIC,
+from .names import (CONTACTS_TOPIC, CONTROLLER_NODE, ODOM_TOPIC, ROSOUT_TOPIC, SCAN_TOPIC,
                     TF_TOPIC)
 
 
@@ -55,7 +55,7 @@ class Recorder:
                 sub(rospy.Subscriber(TF_TOPIC, TFMessage, self.on_tf, queue_size=1000))
             else:
                 sub(rospy.Subscriber(ODOM_TOPIC, Odometry, self.on_odom, queue_size=1000))
-            sub(rospy.Subscriber(ROSOUT_AGG_TOPIC, Log, self.on_log, queue_size=1000))
+            sub(rospy.Subscriber(ROSOUT_TOPIC, Log, self.on_log, queue_size=1000))
             sub(rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self.on_contacts,
                                  queue_size=100))
 

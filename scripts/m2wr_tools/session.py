@@ -13,6 +13,7 @@ import re
 import sys
 import signal
 import time
+import uuid
 import xmlrpc.client
 
 from . import processes
@@ -45,25 +46,33 @@ class Session:
         return self.children.get(name)
 
     def start_master(self, timeout=20.0, attempts=3):
-        """roscore on a free port; returns the master's URI once it answers."""
+        """A ROS master on a free localhost port; returns its URI once it answers.
+        `rosmaster --core`, not roscore: roscore also starts rosout, a roscpp node whose
+        XML-RPC server listens on every interface (roscpp binds it to 0.0.0.0 whatever
+        ROS_HOSTNAME says); the master itself binds to localhost. Nothing here needs rosout:
+        the demo and the batch read the controller's log lines from /rosout directly."""
         for _ in range(attempts):
             self.port = processes.free_port()
             self.master_uri = "http://localhost:%d" % self.port
             self.env = dict(os.environ, ROS_MASTER_URI=self.master_uri, ROS_HOSTNAME="localhost",
                             ROS_LOG_DIR=os.path.join(self.log_dir, "ros"))
             self.env.pop("ROS_IP", None)
-            roscore = self._start("roscore", ["roscore", "-p", str(self.port)])
+            master = self._start("roscore", ["rosmaster", "--core", "-p", str(self.port)])
             deadline = time.monotonic() + timeout
-            while time.monotonic() < deadline and roscore.running():
-                if self.master_pid() is not None and self._rosout_up():
+            while time.monotonic() < deadline and master.running():
+                if self.master_pid() is not None:
+                    # what roscore's roslaunch does: every roslaunch started on this master
+                    # then shares one run id (each would declare its own, and the second
+                    # would stop at "run_id on parameter server does not match")
+                    self.master().setParam("/" + self.name, "/run_id", str(uuid.uuid1()))
                     return self.master_uri
                 time.sleep(0.1)
-            if roscore.running():
-                raise SessionError("roscore on port %d did not answer within %.0f s; see %s"
-                                   % (self.port, timeout, roscore.log_path))
+            if master.running():
+                raise SessionError("the ROS master on port %d did not answer within %.0f s; "
+                                   "see %s" % (self.port, timeout, master.log_path))
             del self.children["roscore"]      # the port was taken meanwhile: try another
-        raise SessionError("roscore would not start (%d attempts); last output:\n%s"
-                           % (attempts, roscore.log_tail()))
+        raise SessionError("the ROS master would not start (%d attempts); last output:\n%s"
+                           % (attempts, master.log_tail()))
 
     def master(self):
         return xmlrpc.client.ServerProxy(self.master_uri)
@@ -74,9 +83,6 @@ class Session:
             return pid if code == 1 else None
         except (OSError, xmlrpc.client.Error):
             return None
-
-    def _rosout_up(self):
-        return self.node_uri("/rosout") is not None
 
     def node_uri(self, node):
         try:

@@ -15,12 +15,15 @@ wake on /clock, not on scans: when no answer came within WAKE_AFTER of wall time
 the last /clock publishes its command before the drive reads it. A loop whose next tick lies
 after the drive's update cannot answer before it (in Gazebo its command too reaches the
 wheels one update later): seen in the series' bug programs when a behaviour is switched on
-just after its loop ticked. So when no answer came within STEP_ON_AFTER of the scan's wait,
-lockstep steps on without a word (before: it stalled the whole `timeout`, 1 s, and logged
+just after its loop ticked. So when no answer came within `step_on_after` (0.25 s, or a
+quarter of `timeout` when that is longer) of the scan's wait, lockstep steps on without a
+word (before: it stalled the whole `timeout`, 1 s, and logged
 `no cmd_vel within`). When no command at all comes for `timeout` (every controller switched
 off, say), lockstep reports it once and stops waiting until the next command arrives,
 instead of stalling at every scan. A controller that answers scans is waited for up to
-STEP_ON_AFTER: far more than it takes even on a loaded machine (a few ms). Time spent paused
+`step_on_after`: far more than it takes (a few ms); where even a rare step-on must not happen
+(the batch runner's metrics must not depend on the machine's load), raise `timeout`
+(lockstep_timeout): the batch runner's 30 s makes it 7.5 s. Time spent paused
 is not silence: a pause (an agent that thinks between steps, a user at the GUI) interrupts
 the wait, and the wait starts afresh, for the same answer, once physics runs again. A reset forgets both the awaited answer and the
 silence (a new episode: its controller is waited for again).
@@ -68,7 +71,8 @@ class LockstepStats:
 
 class Lockstep:
     WAKE_AFTER = 0.005        # [s] wall: how long an answer may take before the wake-up /clock
-    STEP_ON_AFTER = 0.25      # [s] wall: no answer this long after a scan: step on (see above)
+    STEP_ON_AFTER = 0.25      # [s] wall, at least: no answer this long after a scan: step on
+    STEP_ON_SHARE = 0.25      # ... or this share of `timeout` when that is longer
 
     def __init__(self, enabled, timeout, on_timeout, is_shutdown, before_wait=lambda: None,
                  is_paused=lambda: False):
@@ -84,6 +88,11 @@ class Lockstep:
         self._arrived = threading.Condition()
         self._awaited = None                 # (commands counted at a scan, sim time needed by)
         self._quiet = None                   # (commands counted, wall time) unanswered since
+
+    @property
+    def step_on_after(self):
+        """[s] wall: how long a scan's answer is waited for before stepping on."""
+        return min(self.timeout, max(self.STEP_ON_AFTER, self.STEP_ON_SHARE * self.timeout))
 
     def command_arrived(self):
         with self._arrived:
@@ -123,8 +132,7 @@ class Lockstep:
         if outcome is None:
             self.stats.wake_ups += 1
             self.before_wait()
-            outcome = self._wait_for(awaited[0], started + min(self.STEP_ON_AFTER,
-                                                               self.timeout))
+            outcome = self._wait_for(awaited[0], started + self.step_on_after)
         self.stats.wall_waiting += time.monotonic() - started
         if outcome is False:                         # paused: wait again after the pause
             self._quiet = None
