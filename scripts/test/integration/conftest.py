@@ -2,14 +2,17 @@
 scheduler and workers as separate processes on 127.0.0.1 (stopped by PID), and checks of a
 results file against world02's geometry."""
 import json
+import math
 import os
 import subprocess
 import time
+import types
 
 import pytest
 
 from m2wr_tools import processes
 from m2wr_tools.paths import ROOT
+from m2wr_tools.scenarios import FREE_MARGIN, obstacle_distance
 
 EVALUATE = os.path.join(ROOT, "scripts", "evaluate.sh")
 FIXTURES = os.path.join(ROOT, "scripts", "test", "fixtures")
@@ -116,3 +119,37 @@ def run_evaluate():
 @pytest.fixture
 def no_process_left():
     return assert_no_process_left
+
+
+def check_sane(data, outlines, count):
+    """What every run of a batch of the tutorial's controller in world02 must look like: all
+    `count` runs there, free starts, sane metrics (shared by the cluster tests)."""
+    runs = data["runs"]
+    assert len(runs) == count and len({r["run_id"] for r in runs}) == count
+    for r in runs:
+        assert "reason" in r and r["reason"], r
+        assert r["sim_time_s"] >= DURATION - 0.1, r["reason"]
+        assert r["cmd_vel_messages"] > 0
+        # the start is free and the path starts there
+        assert obstacle_distance(outlines, r["x"], r["y"]) >= FREE_MARGIN - 1e-6
+        t0, x0, y0 = r["path"][0]
+        assert t0 < 0.1 and math.hypot(x0 - r["x"], y0 - r["y"]) < 0.05
+        # it drove (0.6 m/s at most), and never left world02's walls
+        assert 0.5 < r["distance_m"] <= 0.6 * DURATION * 1.05
+        for _, x, y in r["path"]:
+            assert -10.0 < x < 10.0 and -10.0 < y < 10.0
+        assert -0.05 <= r["min_clearance_m"] <= obstacle_distance(outlines, r["x"], r["y"]) + 0.05
+        assert (r["contact_events"] == 0) == (r["time_in_contact_s"] == 0.0)
+        assert 0.0 <= r["time_stuck_s"] <= DURATION
+        assert r["success"] == (r["contact_events"] == 0 and r["distance_m"] >= 1.0)
+        assert os.path.exists(r["controller_log"])
+        assert r["controller_exit"] is not None
+        assert r["wall_time_s"] > 0 and r["real_time_factor"] > 0
+
+
+@pytest.fixture
+def batch_kit():
+    """What a test module needs from here besides fixtures (pytest's importlib import mode,
+    which scripts/test.sh uses, lets no test module import conftest by name)."""
+    return types.SimpleNamespace(EVALUATE=EVALUATE, DURATION=DURATION,
+                                 DaskProcesses=DaskProcesses, check_sane=check_sane)

@@ -10,17 +10,14 @@ import socket
 import subprocess
 import time
 
-from test_evaluate_cluster import check_sane
 from m2wr_tools.scene import SCAN_HEIGHT, Scene
-
-from conftest import EVALUATE, DURATION, DaskProcesses
 
 RUNS = 6
 
 
 def test_a_killed_worker_has_its_runs_done_by_the_other(tmp_path, run_evaluate,
-                                                        no_process_left):
-    cluster = DaskProcesses(tmp_path / "dask")
+                                                        no_process_left, batch_kit):
+    cluster = batch_kit.DaskProcesses(tmp_path / "dask")
     output = tmp_path / "batch"
     batch = None
     try:
@@ -31,8 +28,8 @@ def test_a_killed_worker_has_its_runs_done_by_the_other(tmp_path, run_evaluate,
         victim = cluster.children[2]
         with open(tmp_path / "evaluate.log", "wb") as log:
             batch = subprocess.Popen(
-                ["bash", EVALUATE, "--output", str(output), "--no-progress", "--duration",
-                 "%g" % DURATION, "--random", str(RUNS), "--pose-seed", "3", "--scheduler",
+                ["bash", batch_kit.EVALUATE, "--output", str(output), "--no-progress",
+                 "--duration", "%g" % batch_kit.DURATION, "--random", str(RUNS), "--pose-seed", "3", "--scheduler",
                  cluster.address], stdout=log, stderr=subprocess.STDOUT,
                 stdin=subprocess.DEVNULL)
             # the victim is inside a run once its rig forked a controller (zygote.log)
@@ -62,7 +59,7 @@ def test_a_killed_worker_has_its_runs_done_by_the_other(tmp_path, run_evaluate,
         outlines = scene.outlines(SCAN_HEIGHT)
     finally:
         scene.close()
-    check_sane(data, outlines)              # every run present, done, with sane metrics
+    batch_kit.check_sane(data, outlines, RUNS)        # every run present, done, with sane metrics
     assert "runs 6, success" in text
     by_victim = [r for r in data["runs"] if r["worker"].endswith(":%d" % victim.pid)]
     assert len(by_victim) < RUNS            # it died before the end: the others were redone
