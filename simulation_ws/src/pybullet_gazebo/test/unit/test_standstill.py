@@ -136,3 +136,38 @@ def test_a_reset_repeats_the_run_whatever_state_it_interrupted(make_world, m2wr_
         world.step()
         paths.append(episode(world, drive))
     assert paths[1] == paths[0]
+
+
+def test_a_robot_pressed_against_a_barrier_end_turns_free_with_gazebos_friction(make_world,
+                                                                                m2wr_urdf):
+    """Issue 15's wedge: m2wr driven into the east end of world02's row A (x 5.02), then told
+    to turn in place. With Gazebo's wheel-ground friction (mu 1) it turns free; with Bullet's
+    product before (1 x 100, capped at 10) half of these poses stayed pinned (6 of 12 turned
+    under 1 rad in 10 s). One pose still blocks when turned one way: the chassis corner
+    swings into the barrier's face (rigid geometry); the other way it turns free."""
+    pressed, turned_far = 0, 0
+    for y in (4.45, 4.65, 4.81, 5.01):
+        for yaw in (math.pi - 0.4, math.pi, math.pi + 0.4):
+            angles = []
+            for turn in (0.8, -0.8):
+                world = make_world("world02")
+                drive = component(world.spawn_urdf(
+                    "m2wr", m2wr_urdf, Pose.from_xyz_rpy(6.0, y, 0.1, 0.0, 0.0, yaw)), DiffDrive)
+                world.step()
+                drive.set_command(0.5, 0.0)
+                run(world, 4.0)                                   # into the barrier's end
+                if not world.touching():
+                    break
+                drive.set_command(0.0, turn)
+                turned, last = 0.0, world.model_pose("m2wr").rpy[2]
+                for _ in range(100):                               # 10 s, turning in place
+                    run(world, 0.1)
+                    now = world.model_pose("m2wr").rpy[2]
+                    turned += math.atan2(math.sin(now - last), math.cos(now - last))
+                    last = now
+                angles.append(abs(turned))
+            if len(angles) == 2:
+                pressed += 2
+                turned_far += sum(a > 1.0 for a in angles)
+                assert max(angles) > 1.0, (y, yaw, angles)         # one way always frees it
+    assert pressed >= 6 and turned_far >= pressed - 1, (pressed, turned_far)
