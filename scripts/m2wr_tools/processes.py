@@ -62,12 +62,7 @@ class Child:
 
     def log_tail(self, lines=20):
         self._log.flush()
-        try:
-            with open(self.log_path, "rb") as log:
-                text = log.read().decode("utf-8", "replace")
-        except OSError:
-            return ""
-        return "\n".join(text.rstrip().splitlines()[-lines:])
+        return log_tail(self.log_path, lines)
 
     def signal_group(self, signum):
         try:
@@ -221,3 +216,13 @@ def cpu_seconds(pid):
         return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
     except (OSError, ValueError, IndexError):
         return None
+
+
+def log_tail(path, lines=20):
+    """The last `lines` lines of a log file ("" when it cannot be read)."""
+    try:
+        with open(path, "rb") as log:
+            text = log.read().decode("utf-8", "replace")
+    except OSError:
+        return ""
+    return "\n".join(text.rstrip().splitlines()[-lines:])

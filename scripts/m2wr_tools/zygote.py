@@ -214,12 +214,7 @@ class ZygoteChild:
         return code
 
     def log_tail(self, lines=20):
-        try:
-            with open(self.log_path, "rb") as log:
-                text = log.read().decode("utf-8", "replace")
-        except OSError:
-            return ""
-        return "\n".join(text.rstrip().splitlines()[-lines:])
+        return processes.log_tail(self.log_path, lines)
 
     def signal_group(self, signum):
         try:
