@@ -21,11 +21,8 @@ import uuid
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from . import processes, results
+from .processes import Interrupted, raise_on_signals
 from .rig import BATCH_TAG, RunOptions, close_rig, options_dict, run_scenario
-
-
-class Interrupted(Exception):
-    pass
 
 
 PROFILER_CALLBACKS = ("profile", "profile-cycle")
@@ -85,9 +82,7 @@ def run_batch(scenarios, options: RunOptions, scheduler=None, workers=None, resu
         results.write(options.output, records.values(), batch_info)
         return sorted(records.values(), key=lambda r: r["run_id"])
 
-    def interrupt(signum, _frame):
-        raise Interrupted(signal.Signals(signum).name)
-    old_handlers = {s: signal.signal(s, interrupt) for s in (signal.SIGINT, signal.SIGTERM)}
+    old_handlers = raise_on_signals()
     client = cluster = bar = None
     futures = []
     failures = 0

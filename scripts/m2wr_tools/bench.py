@@ -45,10 +45,10 @@ import json
 import math
 import os
 import platform
-import signal
 import sys
 
 from . import benchmath
+from .processes import Interrupted, raise_on_signals
 from .bench_engine import engine_figures
 from .bench_loop import WORLD, START, Listener, launch_to_first_scan, measure_loop, say, soak
 from .benchmath import fmt
@@ -57,10 +57,6 @@ from .session import Session, SessionError
 
 SIMULATOR_DEFAULT_CLOCK_HZ = 100.0
 UNLIMITED = "listeners, watch_rate 0"
-
-
-class Interrupted(Exception):
-    pass
 
 
 # --- the report ---------------------------------------------------------------------------
@@ -164,10 +160,7 @@ def main(argv=None):
     os.makedirs(out, exist_ok=True)
     session = Session(os.path.join(out, "logs", "bench"), name="m2wr_bench")
 
-    def interrupt(signum, _frame):
-        raise Interrupted(signal.Signals(signum).name)
-    signal.signal(signal.SIGINT, interrupt)
-    signal.signal(signal.SIGTERM, interrupt)
+    raise_on_signals()
 
     import pybullet
     figures = {"machine": {"cores": os.cpu_count(), "load_before": "%.2f" % os.getloadavg()[0],

@@ -18,12 +18,12 @@ import argparse
 import json
 import os
 import re
-import signal
 import sys
 import threading
 import time
 
 from . import processes
+from .processes import Interrupted, raise_on_signals
 from .names import CONTACTS_TOPIC, SPAWN_LAUNCH
 from .session import Session, SessionError
 
@@ -41,10 +41,6 @@ DEFAULT_WALL_LIMIT = 300.0                 # [s] wall
 
 def say(text):
     print("[bench_bug] %s" % text, flush=True)
-
-
-class Interrupted(Exception):
-    pass
 
 
 class RunWatch:
@@ -213,10 +209,7 @@ def main(argv=None):
     os.makedirs(out, exist_ok=True)
     session = Session(os.path.join(out, "logs", "bench_bug"), name="m2wr_bench_bug")
 
-    def interrupt(signum, _frame):
-        raise Interrupted(signal.Signals(signum).name)
-    signal.signal(signal.SIGINT, interrupt)
-    signal.signal(signal.SIGTERM, interrupt)
+    raise_on_signals()
     runs, status = [], 0
     load = "%.2f %.2f %.2f" % os.getloadavg()
     try:

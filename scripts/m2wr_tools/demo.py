@@ -20,11 +20,11 @@ import argparse
 import json
 import math
 import os
-import signal
 import sys
 import time
 
 from . import processes, summary
+from .processes import Interrupted, raise_on_signals
 from .names import (COMMAND_TOPIC, CONTROLLER_NODE, DEFAULT_START, DEFAULT_WORLD, ODOM_TOPIC,
                     PAUSE_SERVICE, SCAN_TOPIC, SIMULATOR_NODE, UNPAUSE_SERVICE)
 from .paths import ROOT
@@ -35,10 +35,6 @@ BAG_TOPICS = (SCAN_TOPIC, ODOM_TOPIC, COMMAND_TOPIC)
 PROGRESS_PERIOD = 2.0       # [s] wall
 CLEARANCE_RANGE = 50.0      # [m] obstacles farther than this count as none
 DEFAULT_CLOCK_HZ = 20.0     # [Hz] sim; the simulator also publishes /clock with every scan
-
-
-class Interrupted(Exception):
-    pass
 
 
 def parse_args(argv):
@@ -225,10 +221,7 @@ def main(argv=None):
              "bag": os.path.join(out, "demo_%s.bag" % label)}
     session = Session(os.path.join(out, "logs", "demo"), name="m2wr_demo")
 
-    def interrupt(signum, _frame):
-        raise Interrupted(signal.Signals(signum).name)
-    signal.signal(signal.SIGINT, interrupt)
-    signal.signal(signal.SIGTERM, interrupt)
+    raise_on_signals()
 
     status, data = 0, None
     try:

@@ -226,3 +226,17 @@ def log_tail(path, lines=20):
     except OSError:
         return ""
     return "\n".join(text.rstrip().splitlines()[-lines:])
+
+
+class Interrupted(Exception):
+    """Ctrl-C (SIGINT) or SIGTERM, raised in the main thread by raise_on_signals' handler;
+    its text is the signal's name."""
+
+
+def raise_on_signals():
+    """From now on SIGINT and SIGTERM raise Interrupted in the main thread, so a tool stops
+    what it started and reports instead of printing a traceback. Returns the handlers it
+    replaced, {signal: handler}, for a caller that restores them."""
+    def interrupt(signum, _frame):
+        raise Interrupted(signal.Signals(signum).name)
+    return {s: signal.signal(s, interrupt) for s in (signal.SIGINT, signal.SIGTERM)}
