@@ -93,15 +93,14 @@ class InProcessSim:
         self._drive.set_command(linear_x, angular_z)
         world = self.world
         scans = self._laser.scans_at([world.time_after(k) for k in range(1, steps + 1)])
-        observed = scans[-1] if scans else -1          # index of the step that casts it
-        laser, nothing = (self._laser,), ()
+        observed = scans[-1] if scans else steps       # index of the step that casts it
         touched = set()
+        world.advance(observed, collect=(), touched=touched)
         readings = []
-        for k in range(steps):
-            readings.extend(world.step(collect=laser if k == observed else nothing))
-            for _, other in world.touching():
-                touched.add(other)
-        return self._snapshot(readings, tuple(sorted(touched)))
+        if observed < steps:
+            readings = world.advance(1, collect=(self._laser,), touched=touched)
+            world.advance(steps - observed - 1, collect=(), touched=touched)
+        return self._snapshot(readings, tuple(sorted({other for _, other in touched})))
 
     def _snapshot(self, readings, touched):
         for reading in readings:

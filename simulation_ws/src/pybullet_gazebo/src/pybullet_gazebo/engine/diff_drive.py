@@ -51,7 +51,7 @@ import pybullet
 
 from . import wheel_contact
 from .parameters import ParameterReader
-from .part import Part, PartContext
+from .part import Part, PartContext, next_period_time
 from .transforms import Pose, cross
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
@@ -332,6 +332,19 @@ class DiffDrive(Part):
 
     def skip(self, now):
         pass                    # due() already advanced the schedule; no noise
+
+    def next_activity_time(self, now):
+        """The next wheel update or odometry (see Part); every step with encoder odometry,
+        which integrates the wheel speeds each step, or while a new command waits to be
+        time-stamped (the next before_step does it)."""
+        if self.odometry_source == "encoder" or self._fresh:
+            return now
+        control = self._control
+        soonest = next_period_time(control.last, control.period, now)
+        if self.publish_tf:
+            publish = self._publish
+            soonest = min(soonest, next_period_time(publish.last, publish.period, now))
+        return soonest
 
     def odometry(self):
         """Odometry of the base link now (see the module docstring)."""

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import List, Tuple
 
 from .parameters import ParameterReader
-from .part import Part, PartContext
+from .part import Part, PartContext, next_period_time
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
 
@@ -70,6 +70,9 @@ class JointStatePublisher(Part):
 
     def skip(self, now):
         pass                    # due() already advanced the schedule; no noise
+
+    def next_activity_time(self, now):
+        return next_period_time(self._last, self.period, now)
 
     def reset(self):
         self._last = None

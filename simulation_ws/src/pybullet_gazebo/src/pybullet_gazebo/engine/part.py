@@ -11,6 +11,12 @@ so the World calls them all and never probes a part for what it can do. Per phys
     skip(now)              instead of measure(now) when nobody reads it (World.step with
                            collect=False): the part's schedule and noise stream advance
                            exactly as if it had measured (default: measure, result dropped)
+    next_activity_time(now) -> float   [s] asked after before_step(now): the part promises
+                           that before_step, after_step and due at every sim time t with
+                           now < t < the answer do nothing and answer False, so the World may
+                           run those steps in one Bullet call (World.advance). The default,
+                           `now`, makes it step one step at a time: a part that does
+                           something every step (integrates, applies forces) keeps it.
 
 and on demand:
 
@@ -49,6 +55,17 @@ class PartContext:
     kinetic_legacy_mode: bool = False   # ... and act as if every URDF said legacyMode true
 
 
+SCHEDULE_SLACK = 2e-9      # [s] next_activity_time's margin under a schedule's 1e-9 s tolerance
+
+
+def next_period_time(last, period, now):
+    """next_activity_time of a schedule due once `period` [s] passed since `last` (None:
+    due at once; period 0: every step), with the margin that keeps it on the safe side."""
+    if last is None or period <= 0.0 or now < last:
+        return now
+    return last + period - SCHEDULE_SLACK
+
+
 class Part:
     """Base class of every robot part; see the module docstring for the contract."""
 
@@ -75,6 +92,9 @@ class Part:
 
     def skip(self, now: float) -> None:
         self.measure(now)
+
+    def next_activity_time(self, now: float) -> float:
+        return now
 
     def reset(self) -> None:
         pass

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .part import Part, PartContext
+from .part import Part, PartContext, next_period_time
 from .transforms import Pose
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
@@ -112,6 +112,10 @@ class RaySensor(Part):
         """True when at least 1/update_rate [s] of sim time passed since the last scan (and on
         the first call, and when the sim time went backwards)."""
         return _due(self._last, sim_time, self._period)
+
+    def next_activity_time(self, now):
+        """The next scan (see Part)."""
+        return next_period_time(self._last, self._period, now)
 
     def scans_at(self, times):
         """Indices of the coming sim times `times` [s] (ascending) at which the sensor will

@@ -2,7 +2,8 @@
 services need (model states, reset, delete, spawn, contacts).
 
 Jobs elsewhere: bodies.py builds world models' bodies, robot_loader.py loads URDF robots and
-their parts, placement.py checks requested poses and overlaps, contacts.py tracks touches.
+their parts, placement.py checks requested poses and overlaps, contacts.py tracks touches,
+batching.py runs quiet stretches of steps in one Bullet call (World.advance).
 
 Frames: a model's pose is its model frame in the world, as Gazebo reports it. A robot is one
 Bullet multibody whose model frame is its root link's frame. Bullet reports a body's inertial
@@ -17,6 +18,7 @@ import numpy as np
 import pybullet
 
 from . import wheel_contact
+from .batching import MAX_BATCH, Batcher, GuardedRobot, bounding_radius
 from .bodies import build_model
 from .contacts import ContactTracker
 from .entities import Entity, Reading, Robot
@@ -65,6 +67,9 @@ class World:
         self._body_owner: Dict[int, str] = {}
         self._robots: Optional[List[Robot]] = None  # cache of robots()
         self._stepped = ([], [])                    # cache: (robot, part) pairs, (name, body)
+        self._guarded = ([], [], frozenset())       # cache: GuardedRobots, others, ground bodies
+        self._settled = None        # layout_version after the last step (batches need one)
+        self._batcher = Batcher(client)
         self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
         self._step_simulation = client.stepSimulation   # bound once: called 200 times a second
@@ -128,26 +133,58 @@ class World:
         True = every part's, or a collection of the parts whose readings are wanted (empty:
         none); the other parts due now skip theirs (Part.skip), their schedules and noise
         going on as if they had measured."""
+        return self.advance(1, collect)
+
+    def advance(self, steps, collect=True, touched=None) -> List[Reading]:
+        """`steps` fixed steps, with the same readings (`collect` as for step), contact events,
+        sim time and physics, to the last bit, as `steps` calls of step(); stretches in which
+        nothing can happen between steps (no part's hook acts, no wrench, no contact can
+        start: see batching.py) go to Bullet in one call. `touched`: a set that receives
+        every (robot, other model) pair touching after any of the steps."""
         if self._robots is None:
             self.robots()                   # refreshes the caches after a spawn or delete
-        now = self.sim_time
         parts, bodies = self._stepped
-        for _, part in parts:
-            part.before_step(now, self.step_size)
-        self.wrenches.apply(now)
-        self._step_simulation()
-        self.step_count += 1
-        now = self.sim_time
         readings = []
-        for robot, part in parts:
-            part.after_step(now)
-            if part.due(now):
-                if collect is True or part in collect:
-                    readings.append(Reading(robot, part, part.measure(now)))
-                else:
-                    part.skip(now)
-        self.contacts.update(self.client, now, bodies, self._body_owner, self._grounds)
+        left = steps
+        while left > 0:
+            now = self.sim_time
+            for _, part in parts:
+                part.before_step(now, self.step_size)
+            self.wrenches.apply(now)
+            k = self._quiet_steps(left, now) if left > 1 else 1
+            self._batcher.step(self.step_size, k)
+            self.step_count += k
+            left -= k
+            now = self.sim_time
+            for robot, part in parts:
+                part.after_step(now)
+                if part.due(now):
+                    if collect is True or part in collect:
+                        readings.append(Reading(robot, part, part.measure(now)))
+                    else:
+                        part.skip(now)
+            self.contacts.update(self.client, now, bodies, self._body_owner, self._grounds)
+            if touched is not None:
+                touched.update(self.contacts.touching())
+            self._settled = self.layout_version
         return readings
+
+    def _quiet_steps(self, most, now):
+        """How many of the next `most` steps, the first of which starts now (its before_step
+        hooks done), may run as one Bullet call (see batching.py)."""
+        if self._settled != self.layout_version or not self.wrenches.idle():
+            return 1                        # a teleport, spawn or delete: one step first
+        quiet = min([part.next_activity_time(now) for _, part in self._stepped[0]],
+                    default=math.inf)
+        k = 1
+        while k < most and k < MAX_BATCH and self.time_after(k) < quiet:
+            k += 1
+        k = self._batcher.largest_exact(self.step_size, k)
+        if k > 1:
+            robots, others, grounds = self._guarded
+            if not self._batcher.contact_free(robots, others, grounds, k * self.step_size):
+                return 1
+        return k
 
     def next_command_time(self):
         """Earliest sim time [s] at which a part next reads its command (None: no part takes
@@ -165,7 +202,20 @@ class World:
             self._robots = [e.robot for e in self.entities.values() if e.robot is not None]
             self._stepped = ([(r, p) for r in self._robots for p in r.parts],
                              [(r.name, r.body_id) for r in self._robots])
+            self._guarded = self._guard_lists()
+            self._settled = None
         return list(self._robots)
+
+    def _guard_lists(self):
+        """(GuardedRobots, [(body, radius)] of the other dynamic models, ground bodies):
+        what batching.Batcher.contact_free needs."""
+        robots = [GuardedRobot(self.client, r.body_id) for r in self._robots]
+        others = [(body, bounding_radius(self.client, body, -1))
+                  for e in self.entities.values()
+                  if e.robot is None and not e.static and not e.is_ground
+                  for body in e.body_ids]
+        grounds = frozenset(b for b, owner in self._body_owner.items() if owner in self._grounds)
+        return robots, others, grounds
 
     def entity(self, name) -> Entity:
         try:
@@ -359,6 +409,7 @@ class World:
             link_names=[link.name for link in built.links], link_specs=built.links)
         if built.is_ground:
             self._grounds.add(model.name)
+        self._robots = None                 # the step caches list the dynamic models too
         for body, body_shapes in zip(built.body_ids, built.shapes):
             self._body_owner[body] = model.name
             if built.is_ground:

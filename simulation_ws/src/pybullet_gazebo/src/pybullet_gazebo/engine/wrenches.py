@@ -90,6 +90,10 @@ class WrenchSchedule:
         """(wrench jobs, effort jobs) not yet expired."""
         return len(self._wrenches), len(self._efforts)
 
+    def idle(self):
+        """True when nothing is scheduled and no link is weightless: apply() does nothing."""
+        return not (self._wrenches or self._efforts or self._weightless)
+
     def set_gravity_mode(self, name, body_id, link_index, on):
         if on:
             self._weightless.pop((body_id, link_index), None)
