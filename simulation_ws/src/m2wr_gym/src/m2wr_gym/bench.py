@@ -91,9 +91,11 @@ def one_env(steps, seed=0):
 
 def breakdown(steps, seed=0):
     """Where one control step's CPU time goes in process, [us] each (same env, same run):
-    the whole env.step; Bullet's stepSimulation alone for the step's physics steps; the
-    engine's work around them (drive, schedules, contacts: World.step without readings, minus
-    that physics); the one scan observed; the rest is the environment's own Python."""
+    the whole env.step; Bullet's stepSimulation alone for the step's physics steps, one call
+    each; the engine's work around them (drive, schedules, contacts, batching: World.advance
+    without readings, as the env steps, minus that physics: negative when batching saves
+    more of Bullet's per-call cost than the engine spends); the one scan observed; the rest
+    is the environment's own Python."""
     env = make()
     env.action_space.seed(seed)
     env.reset(seed=seed)
@@ -110,8 +112,7 @@ def breakdown(steps, seed=0):
     for _ in range(steps):                 # alternating, so both meet the same scenes
         sim._drive.set_command(*env.action_space.sample())
         started = cpu()
-        for _ in range(per_action):
-            world.step(collect=())
+        world.advance(per_action, collect=())
         engine += cpu() - started
         started = cpu()
         for _ in range(per_action):

@@ -548,3 +548,75 @@ def test_world02_scan_agrees_with_geometry_and_bullet(client):
     # the corner barrel at (9.07, 7.91), r 0.3
     ahead = caster.cast((0.15, 8.0, 0.15), [(1.0, 0.0, 0.0)], 0.1, 10.0)[0]
     assert ahead == pytest.approx(9.07 - math.sqrt(0.3 ** 2 - 0.09 ** 2) - 0.15, abs=EXACT)
+
+
+# --- a laser's fan: each shape tried only on the beams that can reach it ---------------------
+def _fan_scans(caster, origin, rotation, angle_min, increment, samples, exclude_body=None):
+    """(ranges with the fan hint, ranges without) for a fan built as RaySensor builds it."""
+    angles = angle_min + increment * np.arange(samples)
+    beams = np.stack([np.cos(angles), np.sin(angles), np.zeros(samples)], axis=1)
+    directions = beams @ rotation.T
+    hinted = caster.cast(origin, directions, 0.1, 10.0, exclude_body=exclude_body,
+                         fan=(rotation[:, 0], rotation[:, 1], angle_min, increment))
+    plain = caster.cast(origin, directions, 0.1, 10.0, exclude_body=exclude_body)
+    return hinted, plain
+
+
+@pytest.mark.parametrize("name", ["world01", "world02", "world03"])
+def test_fan_hint_gives_the_same_ranges_to_the_last_bit(name):
+    """The culled kernel against the full one (the caster's code before the hint) on many
+    laser poses in the tutorial's worlds: level and tilted, 180 and 360 degree fans, and
+    fans aimed so that a beam runs exactly through a box's corner or along its face."""
+    import os
+    from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
+    from pybullet_gazebo.engine.world import World
+    from pybullet_gazebo.engine.raycast import rotation_matrices
+    src = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+    spec = load_world(os.path.join(src, "my_worlds", "worlds", name + ".world"),
+                      model_path_from_env(os.path.join(src, "pybullet_gazebo", "models")))
+    client = BulletClient(connection_mode=pybullet.DIRECT)
+    try:
+        world = World(client, spec, 0.005, warn=lambda message: None)
+        caster = world.caster
+        static_shapes = caster._static()[0]
+        rng = np.random.default_rng(sum(map(ord, name)))
+        hits = 0
+        for trial in range(300):
+            origin = np.array([rng.uniform(-9, 9), rng.uniform(-9, 9), rng.uniform(0.05, 0.6)])
+            tilt = rng.normal(0.0, 0.05, 2) if trial % 3 == 0 else (0.0, 0.0)
+            yaw = rng.uniform(-math.pi, math.pi)
+            rotation = rotation_matrices(pybullet.getQuaternionFromEuler((*tilt, yaw)))[0]
+            if trial % 4 == 0:                    # lidar: all round, wrapping at +-pi
+                angle_min, samples = -math.pi, 720
+                increment = 2 * math.pi / samples
+            else:                                 # m2wr's laser
+                angle_min, samples = -math.pi / 2, 720
+                increment = math.pi / (samples - 1)
+            if trial % 2 == 1:                    # a beam exactly through a box corner
+                j = rng.integers(len(static_shapes.kind))
+                corner = static_shapes.position[j] + static_shapes.rotation[j] @ (
+                    static_shapes.size[j] * rng.choice([-1.0, 1.0], 3))
+                local = rotation.T @ (corner - origin)
+                beam = rng.integers(samples)
+                angle_min = math.atan2(local[1], local[0]) - beam * increment
+            hinted, plain = _fan_scans(caster, origin, rotation, angle_min, increment, samples)
+            assert hinted.tobytes() == plain.tobytes(), (name, trial)
+            hits += np.isfinite(plain).sum()
+        assert hits > 300 * 720 * 0.2             # the scans did meet the worlds' models
+    finally:
+        client.disconnect()
+
+
+def test_a_wrong_fan_hint_is_ignored(client):
+    """A hint that does not describe the directions changes nothing."""
+    caster = RayCaster(client)
+    box = client.createMultiBody(0, client.createCollisionShape(pybullet.GEOM_BOX,
+                                                                halfExtents=(0.5, 0.5, 0.5)),
+                                 basePosition=(3.0, 0.0, 0.0))
+    caster.add_body(box, static=True)
+    directions = laser_directions(0.0)
+    wrong = (np.array([0.0, 1.0, 0.0]), np.array([-1.0, 0.0, 0.0]), -math.pi / 2,
+             math.pi / 719)                       # turned by 90 degrees
+    hinted = caster.cast((0, 0, 0), directions, 0.1, 10.0, fan=wrong)
+    assert hinted.tobytes() == caster.cast((0, 0, 0), directions, 0.1, 10.0).tobytes()
+    assert np.isfinite(hinted).sum() > 50

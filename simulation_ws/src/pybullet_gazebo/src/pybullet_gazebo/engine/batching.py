@@ -10,22 +10,28 @@ What may not happen in between, and how each is ruled out:
   no batch while it holds any job or weightless link;
 - joint damping: pybullet adds it once per call, from the joint speeds at the call (a
   robot with damped joints is stepped one step at a time; see `has_joint_damping`);
-- a contact starting or ending (contacts.py reads them after every step): a batch is taken
-  only when no robot can come near anything but itself and the ground models within it.
-  Each robot part (its base and links, as spheres about their centres of mass that hold
-  their collision shapes) grows by how far it can move in the batch, 2 (|v| + |w| r) T +
-  MAX_ACCELERATION T^2 / 2 + CONTACT_SLACK, and the box around them by the most any other
-  dynamic body can move in that time; one getOverlappingObjects on that box must find
-  nothing but the robot and the ground. Bullet's broadphase boxes already hold its contact
-  threshold (0.02 m); CONTACT_SLACK adds more on top.
+- a contact starting or ending (contacts.py reads them after every step): batches run only
+  while no robot can come near anything but itself and the ground models (`safe_time`).
+  A point of a robot moves at most at S_r = max over its links of |v| + |w| r (v, w: the
+  link's velocity, r: the radius about its centre of mass that holds its collision shapes)
+  now, any other dynamic model's at S_o, and neither accelerates by more than
+  MAX_ACCELERATION; so their gap closes by at most 2 (S_r + S_o) t + MAX_ACCELERATION t^2
+  in t seconds (the 2 for good measure). The gap to each model near the robot is Bullet's
+  own distance between their collision shapes (getClosestPoints; models farther away than
+  what can close within the horizon are left out by one getOverlappingObjects); batches
+  run until that closing plus CONTACT_SLACK could reach the smallest gap (Bullet makes a
+  contact point within 0.02 m).
 - floating point: k dt / k must give dt back exactly, and Bullet's own count of internal
   steps, int(k dt / dt), must be k with nothing left over (`exact_substeps`); otherwise a
   smaller k is used.
 """
 import math
 
+import numpy as np
+import pybullet
+
 MAX_BATCH = 20                  # physics steps in one call at most
-MAX_ACCELERATION = 50.0         # [m/s^2] assumed bound on any body's acceleration (5 g)
+MAX_ACCELERATION = 30.0         # [m/s^2] assumed bound on any body's acceleration (3 g)
 CONTACT_SLACK = 0.05            # [m] added to every reach (Bullet's thresholds are 0.02 m)
 
 
@@ -43,9 +49,17 @@ def has_joint_damping(client, body):
     return any(client.getJointInfo(body, j)[6] != 0.0 for j in range(client.getNumJoints(body)))
 
 
-def bounding_radius(client, body, link):
+def bounding_radius(client, body, link, shapes=None):
     """[m] radius about the link's centre of mass (base: link -1) of a sphere holding its
-    collision shapes in any pose: the farthest corner of its present bounding box."""
+    collision shapes in any pose. `shapes`: [(geometry type, dimensions, local position,
+    ...)] as bodies.shape_data gives them (for bodies pybullet cannot report: maximal
+    ones); else pybullet's getCollisionShapeData (local frames relative to the centre of
+    mass). The farthest corner of the link's bounding box when a shape is not a primitive."""
+    if shapes is None:
+        shapes = [entry[2:4] + entry[5:6] for entry in client.getCollisionShapeData(body, link)]
+    radii = [_shape_radius(*shape[:3]) for shape in shapes]
+    if radii and all(r is not None for r in radii):
+        return max(radii)
     low, high = client.getAABB(body, link)
     if link < 0:
         centre = client.getBasePositionAndOrientation(body)[0]
@@ -55,16 +69,49 @@ def bounding_radius(client, body, link):
                          for lo, hi, c in zip(low, high, centre)))
 
 
-def _reach(linear, angular, radius, seconds):
-    """[m] how far any point of a sphere of `radius` about a centre moving at `linear` [m/s]
-    and turning at `angular` [rad/s] can get in `seconds`, with margins."""
-    speed = math.sqrt(linear[0] ** 2 + linear[1] ** 2 + linear[2] ** 2) + radius * math.sqrt(
+def _shape_radius(geometry, dimensions, position):
+    """Distance from the link's centre of mass to the farthest point of a shape
+    (getCollisionShapeData's conventions; a mesh given as its triangles (m, 3, 3)), None
+    for what this cannot bound (planes, meshes known by file name only)."""
+    offset = math.sqrt(sum(c * c for c in position))
+    if geometry == pybullet.GEOM_BOX:
+        return offset + 0.5 * math.sqrt(sum(d * d for d in dimensions))
+    if geometry == pybullet.GEOM_SPHERE:
+        return offset + dimensions[0]
+    if geometry == pybullet.GEOM_CYLINDER:
+        return offset + math.hypot(dimensions[1], 0.5 * dimensions[0])
+    if geometry == pybullet.GEOM_CAPSULE:
+        return offset + dimensions[1] + 0.5 * dimensions[0]
+    if geometry == pybullet.GEOM_MESH and isinstance(dimensions, np.ndarray) and len(dimensions):
+        return offset + float(np.sqrt((dimensions.reshape(-1, 3) ** 2).sum(axis=1).max()))
+    return None
+
+
+def _speed(linear, angular, radius):
+    """[m/s] the fastest any point of a sphere of `radius` about a centre moving at `linear`
+    [m/s] and turning at `angular` [rad/s] moves now."""
+    return math.sqrt(linear[0] ** 2 + linear[1] ** 2 + linear[2] ** 2) + radius * math.sqrt(
         angular[0] ** 2 + angular[1] ** 2 + angular[2] ** 2)
-    return 2.0 * speed * seconds + 0.5 * MAX_ACCELERATION * seconds * seconds + CONTACT_SLACK
+
+
+def closing(speed, seconds):
+    """[m] the most a gap between two bodies whose points move at `speed` [m/s] together now
+    can shrink in `seconds`, CONTACT_SLACK included."""
+    return 2.0 * speed * seconds + MAX_ACCELERATION * seconds * seconds + CONTACT_SLACK
+
+
+def _time_to_close(speed, gap):
+    """[s] the time `closing(speed, t)` takes to reach `gap` [m] (0 when it already does)."""
+    room = gap - CONTACT_SLACK
+    if room <= 0.0:
+        return 0.0
+    # MAX_ACCELERATION t^2 + 2 speed t - room = 0, the positive root in its stable form
+    return room / (speed + math.sqrt(speed * speed + MAX_ACCELERATION * room))
 
 
 class GuardedRobot:
-    """What the contact guard knows of one robot: its body, its links and their radii."""
+    """What the contact guard knows of one robot: its body, its links (-1: the base) and
+    their radii."""
 
     def __init__(self, client, body):
         self.body = body
@@ -81,10 +128,11 @@ class Batcher:
         self._client = client
         self._step = client.stepSimulation            # bound once
         self._set = client.setPhysicsEngineParameter
-        self._base_pose = client.getBasePositionAndOrientation
         self._base_velocity = client.getBaseVelocity
         self._link_states = client.getLinkStates
         self._overlapping = client.getOverlappingObjects
+        self._base_position = client.getBasePositionAndOrientation
+        self._closest = client.getClosestPoints
         self._exact = {}                              # (step size, k) -> exact_substeps
 
     def largest_exact(self, step_size, k):
@@ -111,48 +159,51 @@ class Batcher:
         self._step()
         self._set(fixedTimeStep=step_size, numSubSteps=1)
 
-    def contact_free(self, robots, others, grounds, seconds):
-        """True when, within the next `seconds` of sim time, no robot (GuardedRobot) can
-        touch any body but its own and the bodies in `grounds`; `others` [(body, radius)]:
-        the dynamic bodies that are not robots (their motion widens the search)."""
-        widen = 0.0
+    def safe_time(self, robots, others, grounds, horizon):
+        """[s] of sim time, up to `horizon`, during which no robot (GuardedRobot) can touch
+        any body but its own and the bodies in `grounds` (see the module docstring);
+        `others` [(body, radius)]: the dynamic bodies that are not robots."""
+        other_speed = 0.0
         for body, radius in others:
             linear, angular = self._base_velocity(body)
-            widen = max(widen, _reach(linear, angular, radius, seconds))
-        boxes = []
+            other_speed = max(other_speed, _speed(linear, angular, radius))
+        reached = []
         for robot in robots:
             if robot.damped:
-                return False
-            boxes.append(self._robot_box(robot, seconds))
-        for robot, (low, high, _) in zip(robots, boxes):
-            grow = max([widen] + [reach for other, (_, _, reach) in zip(robots, boxes)
-                                  if other is not robot])
-            hits = self._overlapping([c - grow for c in low], [c + grow for c in high])
-            for body, _ in hits or ():
-                if body != robot.body and body not in grounds:
-                    return False
-        return True
+                return 0.0
+            reached.append(self._reach(robot))
+        safe = horizon
+        for robot, (centre, extent, speed) in zip(robots, reached):
+            speed += max([other_speed] + [s for other, (_, _, s) in zip(robots, reached)
+                                          if other is not robot])
+            far = closing(speed, horizon)
+            grow = extent + far
+            hits = self._overlapping([c - grow for c in centre], [c + grow for c in centre])
+            gap = far
+            for body in {body for body, _ in hits or ()
+                         if body != robot.body and body not in grounds}:
+                for point in self._closest(robot.body, body, far):
+                    gap = min(gap, point[8])
+            if gap < far:
+                safe = min(safe, _time_to_close(speed, gap))
+        return safe
 
-    def _robot_box(self, robot, seconds):
-        """(low, high, reach): the box that holds the robot wherever it can get in `seconds`,
-        and the farthest any of its parts can move [m]."""
-        position = self._base_pose(robot.body)[0]
-        linear, angular = self._base_velocity(robot.body)
-        most = _reach(linear, angular, robot.base_radius, seconds)
-        extent = robot.base_radius + most
-        low = [c - extent for c in position]
-        high = [c + extent for c in position]
+    def _reach(self, robot):
+        """(centre, extent, speed): a cube's centre and half side [m] that hold the robot's
+        collision shapes now, and the speed [m/s] of its fastest point."""
+        body = robot.body
+        linear, angular = self._base_velocity(body)
+        speed = _speed(linear, angular, robot.base_radius)
+        centre = self._base_position(body)[0]
+        extent = robot.base_radius
         if robot.links:
             # (no computeForwardKinematics: it rewrites Bullet's cached link transforms, and
             # the next step would differ in the last bits; after a step they are current)
-            states = self._link_states(robot.body, robot.links, computeLinkVelocity=1)
+            states = self._link_states(body, robot.links, computeLinkVelocity=1)
             for state, radius in zip(states, robot.link_radii):
-                reach = _reach(state[6], state[7], radius, seconds)
-                most = max(most, reach)
-                extent = radius + reach
-                for axis, c in enumerate(state[0]):
-                    if c - extent < low[axis]:
-                        low[axis] = c - extent
-                    if c + extent > high[axis]:
-                        high[axis] = c + extent
-        return low, high, most
+                speed = max(speed, _speed(state[6], state[7], radius))
+                position = state[0]
+                extent = max(extent, radius + max(abs(position[0] - centre[0]),
+                                                  abs(position[1] - centre[1]),
+                                                  abs(position[2] - centre[2])))
+        return centre, extent, speed

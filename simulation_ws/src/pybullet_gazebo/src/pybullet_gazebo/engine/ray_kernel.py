@@ -21,6 +21,8 @@ import numpy as np
 from numba import njit
 
 SPHERE, BOX, CYLINDER, CAPSULE = 0, 1, 2, 3     # shape kinds (sizes: see raycast._Shapes)
+NO_FAN = np.zeros(8)           # the kernels' "the rays are not a known fan": every ray tried
+FAN_MARGIN = 2                 # beams tried beyond each side of a shape's angular window
 _PARALLEL = 1e-12      # squared sine below which a ray counts as parallel to a cylinder's axis
 _JIT = dict(cache=True, error_model="numpy", nogil=True)
 
@@ -115,15 +117,116 @@ def _interval(kind, size, ox, oy, oz, dx, dy, dz):
 
 
 @njit(**_JIT)
+def _fan_windows(fan, kind, r, size, rx, ry, rz, distance2, reach, n, windows):
+    """The rays of a fan that can meet a shape, as up to three index ranges windows[w] =
+    (first, last); returns how many. fan = (x axis (3), y axis (3), angle_min, increment):
+    ray i points along cos(a) x + sin(a) y, a = angle_min + i increment, in the plane the
+    kernels' plane_normal gives; zeros: not a fan, every ray. The shape: kind, rotation r,
+    size as for nearest_hits, its centre at (rx, ry, rz) from the origin (squared distance
+    distance2), bounding radius reach. The rays that can meet it lie between the angles
+    of its box's corners seen in the plane (a box ahead of the origin), or within
+    acos(sqrt(distance2 - reach^2) / rho) of its centre's direction (its bounding sphere,
+    farther than reach * sqrt 2; rho: the centre's distance in the plane); FAN_MARGIN more
+    beams on each side keep rounding out of it. Every ray when the origin is nearer."""
+    increment = fan[7]
+    x = rx * fan[0] + ry * fan[1] + rz * fan[2]
+    y = rx * fan[3] + ry * fan[4] + rz * fan[5]
+    rho2 = x * x + y * y
+    if not (increment > 0.0 and rho2 > 0.0):
+        return _all_rays(n, windows)
+    centre = math.atan2(y, x)
+    if kind == BOX:
+        found, low, high = _box_span(fan, r, size, x, y, rho2)
+        if found:
+            return _index_windows(fan, n, centre + low, centre + high, windows)
+    reach2 = reach * reach
+    if distance2 <= 2.0 * reach2:
+        return _all_rays(n, windows)
+    cosine = math.sqrt(distance2 - reach2) / math.sqrt(rho2)
+    half = 0.0 if cosine >= 1.0 else math.acos(cosine)
+    return _index_windows(fan, n, centre - half, centre + half, windows)
+
+
+@njit(**_JIT)
+def _box_span(fan, r, size, x, y, rho2):
+    """(True, low, high): the angles [rad] of a box's corners seen in the fan's plane,
+    relative to its centre's direction (x, y in the plane), when all of them are ahead of
+    the origin along that direction; (False, 0, 0) otherwise."""
+    length = math.sqrt(rho2)
+    ux, uy = x / length, y / length                  # towards the centre, and across
+    low, high = math.inf, -math.inf
+    for sx in (-1.0, 1.0):
+        for sy in (-1.0, 1.0):
+            for sz in (-1.0, 1.0):
+                cx, cy, cz = sx * size[0], sy * size[1], sz * size[2]
+                wx = r[0, 0] * cx + r[0, 1] * cy + r[0, 2] * cz      # corner - centre, world
+                wy = r[1, 0] * cx + r[1, 1] * cy + r[1, 2] * cz
+                wz = r[2, 0] * cx + r[2, 1] * cy + r[2, 2] * cz
+                px = x + wx * fan[0] + wy * fan[1] + wz * fan[2]     # corner in the plane
+                py = y + wx * fan[3] + wy * fan[4] + wz * fan[5]
+                ahead = px * ux + py * uy
+                if not ahead > 0.0:
+                    return False, 0.0, 0.0
+                slope = (py * ux - px * uy) / ahead
+                low = min(low, slope)
+                high = max(high, slope)
+    return True, math.atan(low), math.atan(high)
+
+
+@njit(**_JIT)
+def _index_windows(fan, n, low, high, windows):
+    """The beams between the angles low and high [rad] (and FAN_MARGIN more each side), the
+    angles taken modulo a turn, as index ranges in windows; returns how many."""
+    angle_min, increment = fan[6], fan[7]
+    count = 0
+    after = 0                      # windows never overlap: each starts after the last
+    for turn in (-2.0 * math.pi, 0.0, 2.0 * math.pi):
+        first = int(math.ceil((low + turn - angle_min) / increment)) - FAN_MARGIN
+        last = int(math.floor((high + turn - angle_min) / increment)) + FAN_MARGIN
+        first = max(first, after)
+        last = min(last, n - 1)
+        if first <= last:
+            windows[count, 0] = first
+            windows[count, 1] = last
+            count += 1
+            after = last + 1
+    return count
+
+
+@njit(**_JIT)
+def _nearest_first(origin, position, bound):
+    """Shape indices by where their bounding spheres start, nearest first."""
+    start = np.empty(position.shape[0])
+    for j in range(position.shape[0]):
+        rx = position[j, 0] - origin[0]
+        ry = position[j, 1] - origin[1]
+        rz = position[j, 2] - origin[2]
+        start[j] = math.sqrt(rx * rx + ry * ry + rz * rz) - bound[j]
+    return np.argsort(start)
+
+
+@njit(**_JIT)
+def _all_rays(n, windows):
+    windows[0, 0] = 0
+    windows[0, 1] = n - 1
+    return 1
+
+
+@njit(**_JIT)
 def nearest_hits(origin, directions, plane_normal, kind, position, rotation, size, bound,
-                 body, exclude_body, range_min, range_max, out):
+                 body, exclude_body, range_min, range_max, out, fan):
     """Lowers out[i] to the nearest entry in [range_min, range_max] of ray i (origin (3,),
     unit directions (n, 3)) into any shape (kind (k,), position (k, 3), rotation (k, 3, 3),
     size (k, 3), bounding radius (k,), body (k,)) whose body is not exclude_body.
     plane_normal (3,): the unit normal of a plane through the origin holding every ray, or
-    zeros; shapes that do not cross that plane are skipped whole."""
+    zeros; shapes that do not cross that plane are skipped whole. fan (8,): when the rays
+    are a fan in that plane (see _fan_windows), each shape is tried only on the rays that
+    can reach it: the same answer, as every other ray misses it; zeros: every ray."""
     in_plane = plane_normal[0] != 0.0 or plane_normal[1] != 0.0 or plane_normal[2] != 0.0
-    for j in range(kind.shape[0]):
+    windows = np.empty((3, 2), dtype=np.int64)
+    culled = in_plane and fan[7] > 0.0
+    order = _nearest_first(origin, position, bound) if culled else np.arange(kind.shape[0])
+    for j in order:
         if body[j] == exclude_body:
             continue
         rx = position[j, 0] - origin[0]
@@ -143,19 +246,28 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
         oy = -(r[0, 1] * rx + r[1, 1] * ry + r[2, 1] * rz)
         oz = -(r[0, 2] * rx + r[1, 2] * ry + r[2, 2] * rz)
         reach2 = (reach + 1e-9) * (reach + 1e-9)
-        for i in range(directions.shape[0]):
-            dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
-            along = rx * dx + ry * dy + rz * dz
-            # rays that miss the bounding sphere, or meet it out of range, are skipped
-            if along < range_min - reach or along > range_max + reach \
-                    or distance2 - along * along > reach2:
-                continue
-            near, far = _interval(kind[j], size[j], ox, oy, oz,
-                                  r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz,
-                                  r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz,
-                                  r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz)
-            if near <= far and range_min <= near <= range_max and near < out[i]:
-                out[i] = near
+        count = _fan_windows(fan, kind[j], r, size[j], rx, ry, rz, distance2, reach + 1e-9,
+                             directions.shape[0], windows) \
+            if culled else _all_rays(directions.shape[0], windows)
+        # a fan's shapes come nearest first: a ray that already hit nearer than this shape's
+        # bounding sphere starts cannot hit it nearer (its own nearest is at least that far)
+        beyond = distance - reach - 1e-9 if culled else -math.inf
+        for w in range(count):
+            for i in range(windows[w, 0], windows[w, 1] + 1):
+                if out[i] < beyond:
+                    continue
+                dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
+                along = rx * dx + ry * dy + rz * dz
+                # rays that miss the bounding sphere, or meet it out of range, are skipped
+                if along < range_min - reach or along > range_max + reach \
+                        or distance2 - along * along > reach2:
+                    continue
+                near, far = _interval(kind[j], size[j], ox, oy, oz,
+                                      r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz,
+                                      r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz,
+                                      r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz)
+                if near <= far and range_min <= near <= range_max and near < out[i]:
+                    out[i] = near
 
 
 @njit(**_JIT)
@@ -182,14 +294,18 @@ def _triangle_hit(ox, oy, oz, dx, dy, dz, t):
 
 @njit(**_JIT)
 def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, bound, start,
-                      count, triangles, body, exclude_body, range_min, range_max, out):
+                      count, triangles, body, exclude_body, range_min, range_max, out,
+                      fan):
     """Lowers out[i] to the nearest crossing in [range_min, range_max] of ray i (origin (3,),
     unit directions (n, 3)) with a triangle of any mesh (position (k, 3), rotation (k, 3, 3),
     bounding radius about its origin (k,), triangles[start[j]:start[j] + count[j]] in its own
     frame, body (k,)) whose body is not exclude_body. A mesh is a surface: a triangle is hit
-    from either side. plane_normal as for nearest_hits."""
+    from either side. plane_normal and fan as for nearest_hits."""
     in_plane = plane_normal[0] != 0.0 or plane_normal[1] != 0.0 or plane_normal[2] != 0.0
-    for j in range(position.shape[0]):
+    windows = np.empty((3, 2), dtype=np.int64)
+    culled = in_plane and fan[7] > 0.0
+    order = _nearest_first(origin, position, bound) if culled else np.arange(position.shape[0])
+    for j in order:
         if body[j] == exclude_body:
             continue
         rx = position[j, 0] - origin[0]
@@ -208,38 +324,47 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
         oy = -(r[0, 1] * rx + r[1, 1] * ry + r[2, 1] * rz)
         oz = -(r[0, 2] * rx + r[1, 2] * ry + r[2, 2] * rz)
         reach2 = (reach + 1e-9) * (reach + 1e-9)
-        for i in range(directions.shape[0]):
-            dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
-            along = rx * dx + ry * dy + rz * dz
-            if along < range_min - reach or along > range_max + reach \
-                    or distance2 - along * along > reach2:
-                continue
-            lx = r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz
-            ly = r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz
-            lz = r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz
-            for t in range(start[j], start[j] + count[j]):
-                hit = _triangle_hit(ox, oy, oz, lx, ly, lz, triangles[t])
-                if range_min <= hit <= range_max and hit < out[i]:
-                    out[i] = hit
+        windows_count = _fan_windows(fan, SPHERE, r, bound[j:j + 1], rx, ry, rz, distance2,
+                                     reach + 1e-9, directions.shape[0], windows) \
+            if culled else _all_rays(directions.shape[0], windows)
+        beyond = distance - reach - 1e-9 if culled else -math.inf     # as in nearest_hits
+        for w in range(windows_count):
+            for i in range(windows[w, 0], windows[w, 1] + 1):
+                if out[i] < beyond:
+                    continue
+                dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
+                along = rx * dx + ry * dy + rz * dz
+                if along < range_min - reach or along > range_max + reach \
+                        or distance2 - along * along > reach2:
+                    continue
+                lx = r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz
+                ly = r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz
+                lz = r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz
+                for t in range(start[j], start[j] + count[j]):
+                    hit = _triangle_hit(ox, oy, oz, lx, ly, lz, triangles[t])
+                    if range_min <= hit <= range_max and hit < out[i]:
+                        out[i] = hit
 
 
 def warm_up():
-    """Compiles (or loads from numba's cache) nearest_hits with the argument types the
+    """Compiles (or loads from numba's cache) the kernels with the argument types the
     caster passes; returns the seconds it took."""
     import time
     start = time.perf_counter()
-    out = np.full(2, np.inf)
-    nearest_hits(np.zeros(3), np.eye(3)[:2].copy(), np.array([0.0, 0.0, 1.0]),
-                 np.array([BOX], dtype=np.int64), np.array([[2.0, 0.0, 0.0]]),
-                 np.eye(3).reshape(1, 3, 3).copy(), np.full((1, 3), 0.5), np.array([0.9]),
-                 np.array([7], dtype=np.int64), -1, 0.0, 10.0, out)
-    assert out[0] == 1.5 and out[1] == np.inf, out
-    out = np.full(2, np.inf)
-    triangle = np.array([[[0.0, -1.0, -1.0], [0.0, 1.0, -1.0], [0.0, 0.0, 1.0]]])
-    nearest_mesh_hits(np.zeros(3), np.eye(3)[:2].copy(), np.array([0.0, 0.0, 1.0]),
-                      np.array([[2.0, 0.0, 0.0]]), np.eye(3).reshape(1, 3, 3).copy(),
-                      np.array([1.5]), np.array([0], dtype=np.int64),
-                      np.array([1], dtype=np.int64), triangle, np.array([7], dtype=np.int64),
-                      -1, 0.0, 10.0, out)
-    assert out[0] == 2.0 and out[1] == np.inf, out
+    fan = np.array([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, math.pi / 2])   # rays at 0 and 90 deg
+    for hint in (NO_FAN, fan):
+        out = np.full(2, np.inf)
+        nearest_hits(np.zeros(3), np.eye(3)[:2].copy(), np.array([0.0, 0.0, 1.0]),
+                     np.array([BOX], dtype=np.int64), np.array([[2.0, 0.0, 0.0]]),
+                     np.eye(3).reshape(1, 3, 3).copy(), np.full((1, 3), 0.5), np.array([0.9]),
+                     np.array([7], dtype=np.int64), -1, 0.0, 10.0, out, hint)
+        assert out[0] == 1.5 and out[1] == np.inf, out
+        out = np.full(2, np.inf)
+        triangle = np.array([[[0.0, -1.0, -1.0], [0.0, 1.0, -1.0], [0.0, 0.0, 1.0]]])
+        nearest_mesh_hits(np.zeros(3), np.eye(3)[:2].copy(), np.array([0.0, 0.0, 1.0]),
+                          np.array([[2.0, 0.0, 0.0]]), np.eye(3).reshape(1, 3, 3).copy(),
+                          np.array([1.5]), np.array([0], dtype=np.int64),
+                          np.array([1], dtype=np.int64), triangle, np.array([7], dtype=np.int64),
+                          -1, 0.0, 10.0, out, hint)
+        assert out[0] == 2.0 and out[1] == np.inf, out
     return time.perf_counter() - start

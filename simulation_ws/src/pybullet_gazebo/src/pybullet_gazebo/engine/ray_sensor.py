@@ -152,8 +152,11 @@ class RaySensor(Part):
         spec = self.spec
         pose = self.sensor_pose()
         directions = self._beams @ pose.matrix.T
+        axes = pose.matrix
         ranges = self._caster.cast(pose.position, directions, spec.range_min,
-                                   spec.range_max, exclude_body=self.body_id)
+                                   spec.range_max, exclude_body=self.body_id,
+                                   fan=(axes[:, 0], axes[:, 1], spec.min_angle,
+                                        self.angle_increment))
         if spec.noise_stddev > 0.0 or spec.noise_mean != 0.0:
             # one draw per beam whether it hit or not, so the stream does not depend on the scene
             noise = self.rng.normal(spec.noise_mean, spec.noise_stddev, len(ranges))

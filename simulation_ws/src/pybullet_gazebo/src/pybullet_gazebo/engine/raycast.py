@@ -27,6 +27,8 @@ tests the segment [range_min, range_max] along its direction; hits nearer than r
 ignored as if the ray started there, and a ray starting inside a shape does not hit that
 shape. Distances are measured from the origin [m]; no hit is `inf`.
 """
+import math
+
 import numpy as np
 import pybullet
 
@@ -337,10 +339,13 @@ class RayCaster:
         return group.place(self._client)
 
     # --- casting -------------------------------------------------------------------------
-    def cast(self, origin, directions, range_min, range_max, exclude_body=None):
+    def cast(self, origin, directions, range_min, range_max, exclude_body=None, fan=None):
         """Distances [m] from `origin` (3,) along each of `directions` (n, 3) (need not be
         unit) to the nearest hit in [range_min, range_max]; inf where nothing is hit there.
-        Shapes of `exclude_body` are ignored."""
+        Shapes of `exclude_body` are ignored. `fan` (x axis (3,), y axis (3,), angle_min,
+        angle_increment [rad]): a hint that direction i is cos(a) x + sin(a) y with a =
+        angle_min + i angle_increment (a laser's fan); each shape is then tried only on the
+        rays that can reach it. The distances are the same with or without it."""
         origin = np.asarray(origin, dtype=float).reshape(3)
         directions = np.asarray(directions, dtype=float).reshape(-1, 3)
         norms = np.sqrt((directions * directions) @ _ONES)
@@ -363,6 +368,7 @@ class RayCaster:
         normal = None
         if shapes is not None or static_meshes is not None or dynamic_meshes is not None:
             normal = self._coplanar_normal(directions)
+        fan = ray_kernel.NO_FAN if fan is None or normal is None else _fan_array(fan, directions)
         for meshes in (static_meshes, dynamic_meshes):
             if meshes is not None:
                 ray_kernel.nearest_mesh_hits(
@@ -370,13 +376,13 @@ class RayCaster:
                     meshes.position, meshes.rotation, meshes.bound, meshes.start, meshes.count,
                     meshes.triangles, meshes.body,
                     -1 if exclude_body is None else int(exclude_body), range_min, range_max,
-                    result)
+                    result, fan)
         if shapes is not None:
             ray_kernel.nearest_hits(origin, directions, _NO_PLANE if normal is None else normal,
                                     shapes.kind, shapes.position, shapes.rotation, shapes.size,
                                     shapes.bound, shapes.body,
                                     -1 if exclude_body is None else int(exclude_body),
-                                    range_min, range_max, result)
+                                    range_min, range_max, result, fan)
         return result
 
     def _join(self, static_shapes, dynamic_shapes):
@@ -414,3 +420,23 @@ class RayCaster:
 
 
 _NO_PLANE = np.zeros(3)            # the kernel's "no common plane"
+_FAN_CHECK = 1e-6                  # how closely a fan hint must give the end directions
+
+
+def _fan_array(fan, directions):
+    """The kernels' fan (8,) for a cast's hint, checked on the first and last (unit)
+    directions; the kernels' NO_FAN when the hint does not describe them."""
+    x_axis, y_axis, angle_min, increment = fan
+    x0, x1, x2 = (float(c) for c in x_axis)
+    y0, y1, y2 = (float(c) for c in y_axis)
+    angle_min, increment = float(angle_min), float(increment)
+    if not increment > 0.0:
+        return ray_kernel.NO_FAN
+    last = angle_min + increment * (len(directions) - 1)
+    for angle, (d0, d1, d2) in ((angle_min, directions[0].tolist()),
+                                (last, directions[-1].tolist())):
+        c, s = math.cos(angle), math.sin(angle)
+        if not (abs(c * x0 + s * y0 - d0) <= _FAN_CHECK and abs(c * x1 + s * y1 - d1)
+                <= _FAN_CHECK and abs(c * x2 + s * y2 - d2) <= _FAN_CHECK):
+            return ray_kernel.NO_FAN
+    return np.array([x0, x1, x2, y0, y1, y2, angle_min, increment])

@@ -69,6 +69,8 @@ class World:
         self._stepped = ([], [])                    # cache: (robot, part) pairs, (name, body)
         self._guarded = ([], [], frozenset())       # cache: GuardedRobots, others, ground bodies
         self._settled = None        # layout_version after the last step (batches need one)
+        self._single_until = -1     # step count before which advance steps one by one
+        self._safe_until = -1       # step count up to which no contact can start
         self._batcher = Batcher(client)
         self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
@@ -146,6 +148,7 @@ class World:
         parts, bodies = self._stepped
         readings = []
         left = steps
+        self._safe_until = self._single_until = -1     # the guard's answers hold for one call
         while left > 0:
             now = self.sim_time
             for _, part in parts:
@@ -172,6 +175,8 @@ class World:
     def _quiet_steps(self, most, now):
         """How many of the next `most` steps, the first of which starts now (its before_step
         hooks done), may run as one Bullet call (see batching.py)."""
+        if self.step_count < self._single_until:
+            return 1                        # the contact guard said no for this stretch
         if self._settled != self.layout_version or not self.wrenches.idle():
             return 1                        # a teleport, spawn or delete: one step first
         quiet = min([part.next_activity_time(now) for _, part in self._stepped[0]],
@@ -180,9 +185,14 @@ class World:
         while k < most and k < MAX_BATCH and self.time_after(k) < quiet:
             k += 1
         k = self._batcher.largest_exact(self.step_size, k)
-        if k > 1:
+        if k > 1 and self.step_count + k > self._safe_until:
             robots, others, grounds = self._guarded
-            if not self._batcher.contact_free(robots, others, grounds, k * self.step_size):
+            safe = self._batcher.safe_time(robots, others, grounds, most * self.step_size)
+            self._safe_until = self.step_count + int(safe / self.step_size)
+            wanted, k = k, self._batcher.largest_exact(
+                self.step_size, min(k, self._safe_until - self.step_count))
+            if k < 2:
+                self._single_until = self.step_count + wanted
                 return 1
         return k
 
@@ -210,10 +220,10 @@ class World:
         """(GuardedRobots, [(body, radius)] of the other dynamic models, ground bodies):
         what batching.Batcher.contact_free needs."""
         robots = [GuardedRobot(self.client, r.body_id) for r in self._robots]
-        others = [(body, bounding_radius(self.client, body, -1))
+        others = [(body, bounding_radius(self.client, body, -1, shapes))
                   for e in self.entities.values()
                   if e.robot is None and not e.static and not e.is_ground
-                  for body in e.body_ids]
+                  for body, shapes in zip(e.body_ids, e.shapes or [None] * len(e.body_ids))]
         grounds = frozenset(b for b, owner in self._body_owner.items() if owner in self._grounds)
         return robots, others, grounds
 

@@ -1,0 +1,236 @@
+"""World.advance runs quiet stretches of physics steps in one Bullet call: everything a user
+sees (poses, scans with their noise, odometry, contact events, sim time) is bit for bit what
+stepping one step at a time gives, and the stretches really are batched."""
+import math
+import os
+
+import numpy as np
+import pybullet
+import pytest
+import xacro
+from pybullet_utils.bullet_client import BulletClient
+
+from pybullet_gazebo.engine import batching, registry
+from pybullet_gazebo.engine.diff_drive import DiffDrive
+from pybullet_gazebo.engine.part import Part
+from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
+from pybullet_gazebo.engine.transforms import Pose
+from pybullet_gazebo.engine.world import World
+
+SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+MODELS = os.path.join(SRC, "pybullet_gazebo", "models")
+STEP = 0.005          # [s]
+CONTROL = 20          # physics steps per command, as the Gym environment's 10 Hz
+
+
+@pytest.fixture(scope="module")
+def m2wr_urdf():
+    return xacro.process_file(os.path.join(SRC, "m2wr_description", "urdf", "m2wr.xacro")).toxml()
+
+
+@pytest.fixture(scope="module")
+def world02():
+    return load_world(os.path.join(SRC, "my_worlds", "worlds", "world02.world"),
+                      model_path_from_env(MODELS))
+
+
+@pytest.fixture
+def make_world():
+    clients = []
+
+    def make(spec, seed=3):
+        client = BulletClient(connection_mode=pybullet.DIRECT)
+        clients.append(client)
+        return World(client, spec, STEP, seed=seed, warn=lambda message: None)
+    yield make
+    for client in clients:
+        client.disconnect()
+
+
+class Calls:
+    """Counts the Bullet calls of a World and the steps they made."""
+
+    def __init__(self, world):
+        self.calls, self.steps = 0, 0
+        step = world._batcher.step
+
+        def counted(step_size, k):
+            self.calls += 1
+            self.steps += k
+            step(step_size, k)
+        world._batcher.step = counted
+
+
+def state(world, robot):
+    client = world.client
+    return (world.step_count, world.sim_time, client.getBasePositionAndOrientation(robot.body_id),
+            client.getBaseVelocity(robot.body_id),
+            tuple(s[:2] for s in client.getJointStates(robot.body_id,
+                                                       range(client.getNumJoints(robot.body_id)))))
+
+
+def readings_record(readings):
+    """What each reading says, comparable bit for bit."""
+    out = []
+    for r in readings:
+        data = r.data
+        if hasattr(data, "ranges"):
+            out.append(("scan", data.stamp, data.ranges.tobytes()))
+        elif hasattr(data, "pose"):
+            out.append(("odom", data.pose.position, data.pose.orientation,
+                        tuple(data.linear), tuple(data.angular)))
+        else:
+            out.append(("joints", tuple(data.positions), tuple(data.velocities)))
+    return out
+
+
+def drive(world, robot, commands, batched, between=None):
+    """Each command held for CONTROL steps, by advance (batched) or by step; returns the
+    state and the readings after each, and the contact events."""
+    drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
+    trace = []
+    for index, command in enumerate(commands):
+        if between is not None:
+            between(index)
+        drive_part.set_command(*command)
+        if batched:
+            touched = set()
+            readings = world.advance(CONTROL, touched=touched)
+        else:
+            readings, touched = [], set()
+            for _ in range(CONTROL):
+                readings += world.step()
+                touched.update(world.touching())
+        trace.append((state(world, robot), readings_record(readings), sorted(touched)))
+    return trace, list(world.contact_events)
+
+
+COMMANDS = [(0.0, 0.0), (0.5, 0.0), (0.5, 0.6), (0.0, 0.0), (-0.3, -0.8), (0.6, 0.2),
+            (0.0, 1.0), (0.3, 0.0)] * 2
+
+
+def test_driving_and_turning_in_world02_is_bit_identical_and_batched(make_world, world02,
+                                                                     m2wr_urdf):
+    runs = {}
+    for batched in (False, True):
+        world = make_world(world02)
+        robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(0, 8, 0.1, 0, 0, -0.4))
+        calls = Calls(world)
+        runs[batched] = drive(world, robot, COMMANDS, batched), calls
+    (single, _), single_calls = runs[False]
+    (trace, _), calls = runs[True]
+    assert trace == single                        # poses, velocities, joints, readings
+    assert single_calls.calls == single_calls.steps == calls.steps == len(COMMANDS) * CONTROL
+    assert calls.calls < calls.steps / 3          # most of it in stretches of 9 steps
+    scans = [r for _, readings, _ in trace for r in readings if r[0] == "scan"]
+    assert len(scans) == len(COMMANDS) * 2        # 20 Hz: every scan read, noise and all
+
+
+def test_driving_into_a_barrier_gives_the_same_contact_events(make_world, world02, m2wr_urdf):
+    """Row A's face is ~1.7 m ahead: the robot drives into it at 0.5 m/s and pushes on."""
+    runs = {}
+    for batched in (False, True):
+        world = make_world(world02)
+        robot = world.spawn_urdf("m2wr", m2wr_urdf,
+                                 Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2))
+        calls = Calls(world)
+        runs[batched] = drive(world, robot, [(0.5, 0.0)] * 30 + [(-0.5, 0.0)] * 5, batched), calls
+    (single, single_events), _ = runs[False]
+    (trace, events), calls = runs[True]
+    assert events and events[0].other.startswith("jersey_barrier")
+    assert events == single_events                # same onsets, same sim times
+    assert trace == single                        # touched sets step by step too
+    assert any(touched for _, _, touched in trace)
+    assert calls.calls < calls.steps / 2          # batched while clear of the barrier
+
+
+def test_a_wrench_and_a_reset_in_between_stay_identical(make_world, world02, m2wr_urdf):
+    """A body wrench on the chassis for 0.3 s (applied per step: no batch while it is
+    scheduled), and reset_simulation half way."""
+    runs = {}
+    for batched in (False, True):
+        world = make_world(world02)
+        robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(-2, 0, 0.1, 0, 0, 1.0))
+
+        def between(index, world=world, robot=robot):
+            if index == 3:
+                world.wrenches.add_body_wrench("m2wr::link_chassis", robot.body_id, -1,
+                                               (0.0, 8.0, 0.0), (0.0, 0.0, 1.5),
+                                               world.sim_time + 0.02, 0.3, world.sim_time)
+            if index == 8:
+                world.reset_simulation()
+        runs[batched] = drive(world, robot, COMMANDS, batched, between)
+    assert runs[True] == runs[False]
+
+
+class EveryStep(Part):
+    """A part that says nothing of when it acts: the World must step one step at a time."""
+    KEY = "libtest_every_step.so"
+
+    def __init__(self):
+        self.calls = 0
+
+    @classmethod
+    def build(cls, context, plugin):
+        return cls()
+
+    def before_step(self, now, dt):
+        self.calls += 1
+
+
+def test_a_part_without_a_schedule_keeps_single_steps(make_world, world02, m2wr_urdf,
+                                                      monkeypatch):
+    monkeypatch.setitem(registry.PLUGIN_PARTS, EveryStep.KEY, EveryStep)
+    urdf = m2wr_urdf.replace("</robot>", '<gazebo><plugin name="every" '
+                             'filename="libtest_every_step.so"/></gazebo></robot>')
+    world = make_world(world02)
+    robot = world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(0, 8, 0.1))
+    calls = Calls(world)
+    world.advance(100)
+    part = next(p for p in robot.parts if isinstance(p, EveryStep))
+    assert calls.calls == calls.steps == part.calls == 100
+
+
+def test_damped_joints_keep_single_steps(make_world, world02, m2wr_urdf):
+    """pybullet applies joint damping once per call: a batch would not be identical."""
+    urdf = m2wr_urdf.replace('<limit effort="10000" velocity="1000"/>',
+                             '<limit effort="10000" velocity="1000"/>'
+                             '<dynamics damping="0.05"/>')
+    assert urdf != m2wr_urdf
+    world = make_world(world02)
+    world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(0, 8, 0.1))
+    calls = Calls(world)
+    world.advance(100)
+    assert calls.calls == 100
+
+
+def test_bullet_is_left_at_one_step_per_call(make_world, world02, m2wr_urdf):
+    """After advance, Bullet steps one step of the World's size per stepSimulation, as
+    World.step, set_step_size and anyone's direct call expect."""
+    world = make_world(world02)
+    world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(0, 8, 0.1))
+    calls = Calls(world)
+    world.advance(40)
+    assert calls.calls < 40
+    parameters = world.client.getPhysicsEngineParameters()
+    assert parameters["fixedTimeStep"] == STEP and parameters["numSubSteps"] == 1
+
+
+@pytest.mark.parametrize("k, exact", [(2, True), (9, True), (10, True), (29, False)])
+def test_exact_substeps_follow_bullets_arithmetic(k, exact):
+    """Bullet counts int(k dt / (k dt / k)) internal steps of k dt / k: 29 x 5 ms is not
+    exactly 29 steps of 5 ms in doubles, so it is never batched that way."""
+    assert batching.exact_substeps(STEP, k) is exact
+
+
+def test_safe_time_shrinks_near_an_obstacle(make_world, world02, m2wr_urdf):
+    """The contact guard: far from everything the whole horizon is safe; facing a barrier
+    0.1 m away at speed, no batch at all."""
+    world = make_world(world02)
+    world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(0, 8, 0.1))
+    world.advance(40)
+    robots, others, grounds = world._guarded
+    assert world._batcher.safe_time(robots, others, grounds, 0.1) == 0.1
+    world.set_model_state("m2wr", Pose.from_xyz_rpy(0, 5.55, 0.1, 0, 0, -math.pi / 2))
+    world.advance(40)
+    assert world._batcher.safe_time(robots, others, grounds, 0.1) < 2 * STEP
