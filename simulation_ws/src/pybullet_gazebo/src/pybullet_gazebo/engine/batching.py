@@ -87,13 +87,6 @@ def _shape_radius(geometry, dimensions, position):
     return None
 
 
-def _speed(linear, angular, radius):
-    """[m/s] the fastest any point of a sphere of `radius` about a centre moving at `linear`
-    [m/s] and turning at `angular` [rad/s] moves now."""
-    return math.sqrt(linear[0] ** 2 + linear[1] ** 2 + linear[2] ** 2) + radius * math.sqrt(
-        angular[0] ** 2 + angular[1] ** 2 + angular[2] ** 2)
-
-
 def closing(speed, seconds):
     """[m] the most a gap between two bodies whose points move at `speed` [m/s] together now
     can shrink in `seconds`, CONTACT_SLACK included."""
@@ -163,10 +156,12 @@ class Batcher:
         """[s] of sim time, up to `horizon`, during which no robot (GuardedRobot) can touch
         any body but its own and the bodies in `grounds` (see the module docstring);
         `others` [(body, radius)]: the dynamic bodies that are not robots."""
+        velocity, sqrt = self._base_velocity, math.sqrt
         other_speed = 0.0
         for body, radius in others:
-            linear, angular = self._base_velocity(body)
-            other_speed = max(other_speed, _speed(linear, angular, radius))
+            (vx, vy, vz), (wx, wy, wz) = velocity(body)
+            other_speed = max(other_speed, sqrt(vx * vx + vy * vy + vz * vz)
+                              + radius * sqrt(wx * wx + wy * wy + wz * wz))
         reached = []
         for robot in robots:
             if robot.damped:
@@ -174,8 +169,11 @@ class Batcher:
             reached.append(self._reach(robot))
         safe = horizon
         for robot, (centre, extent, speed) in zip(robots, reached):
-            speed += max([other_speed] + [s for other, (_, _, s) in zip(robots, reached)
-                                          if other is not robot])
+            if len(robots) > 1:
+                speed += max([other_speed] + [s for other, (_, _, s) in zip(robots, reached)
+                                              if other is not robot])
+            else:
+                speed += other_speed
             far = closing(speed, horizon)
             grow = extent + far
             hits = self._overlapping([c - grow for c in centre], [c + grow for c in centre])
@@ -191,19 +189,20 @@ class Batcher:
     def _reach(self, robot):
         """(centre, extent, speed): a cube's centre and half side [m] that hold the robot's
         collision shapes now, and the speed [m/s] of its fastest point."""
-        body = robot.body
-        linear, angular = self._base_velocity(body)
-        speed = _speed(linear, angular, robot.base_radius)
-        centre = self._base_position(body)[0]
+        body, sqrt = robot.body, math.sqrt
+        (vx, vy, vz), (wx, wy, wz) = self._base_velocity(body)
+        speed = sqrt(vx * vx + vy * vy + vz * vz) + robot.base_radius * sqrt(
+            wx * wx + wy * wy + wz * wz)
+        cx, cy, cz = self._base_position(body)[0]
         extent = robot.base_radius
         if robot.links:
             # (no computeForwardKinematics: it rewrites Bullet's cached link transforms, and
             # the next step would differ in the last bits; after a step they are current)
             states = self._link_states(body, robot.links, computeLinkVelocity=1)
             for state, radius in zip(states, robot.link_radii):
-                speed = max(speed, _speed(state[6], state[7], radius))
-                position = state[0]
-                extent = max(extent, radius + max(abs(position[0] - centre[0]),
-                                                  abs(position[1] - centre[1]),
-                                                  abs(position[2] - centre[2])))
-        return centre, extent, speed
+                (vx, vy, vz), (wx, wy, wz) = state[6], state[7]
+                speed = max(speed, sqrt(vx * vx + vy * vy + vz * vz)
+                            + radius * sqrt(wx * wx + wy * wy + wz * wz))
+                px, py, pz = state[0]
+                extent = max(extent, radius + max(abs(px - cx), abs(py - cy), abs(pz - cz)))
+        return (cx, cy, cz), extent, speed

@@ -28,6 +28,27 @@ _JIT = dict(cache=True, error_model="numpy", nogil=True)
 
 
 @njit(**_JIT)
+def _divided_rows(rows, norms, out):
+    """out[i] = rows[i] / norms[i]; False (out unfinished) when a norm is not a finite
+    positive number."""
+    for i in range(rows.shape[0]):
+        norm = norms[i]
+        if not (norm > 0.0 and norm < math.inf):
+            return False
+        out[i, 0] = rows[i, 0] / norm
+        out[i, 1] = rows[i, 1] / norm
+        out[i, 2] = rows[i, 2] / norm
+    return True
+
+
+def unit_rows(rows, norms):
+    """rows (n, 3) divided by their norms (n,) (the same IEEE divisions numpy makes), or None
+    when a norm is not a finite positive number."""
+    out = np.empty((rows.shape[0], 3))
+    return out if _divided_rows(np.ascontiguousarray(rows), norms, out) else None
+
+
+@njit(**_JIT)
 def _fmin(a, b):
     if a != a:
         return b
@@ -351,6 +372,7 @@ def warm_up():
     caster passes; returns the seconds it took."""
     import time
     start = time.perf_counter()
+    assert unit_rows(np.array([[3.0, 0.0, 4.0]]), np.array([5.0]))[0, 2] == 0.8
     fan = np.array([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, math.pi / 2])   # rays at 0 and 90 deg
     for hint in (NO_FAN, fan):
         out = np.full(2, np.inf)

@@ -151,8 +151,8 @@ class RaySensor(Part):
         """Scan now; returns a LaserScanData stamped `sim_time` [s]."""
         spec = self.spec
         pose = self.sensor_pose()
-        directions = self._beams @ pose.matrix.T
         axes = pose.matrix
+        directions = self._beams @ axes.T
         ranges = self._caster.cast(pose.position, directions, spec.range_min,
                                    spec.range_max, exclude_body=self.body_id,
                                    fan=(axes[:, 0], axes[:, 1], spec.min_angle,
@@ -160,9 +160,8 @@ class RaySensor(Part):
         if spec.noise_stddev > 0.0 or spec.noise_mean != 0.0:
             # one draw per beam whether it hit or not, so the stream does not depend on the scene
             noise = self.rng.normal(spec.noise_mean, spec.noise_stddev, len(ranges))
-            hit = np.isfinite(ranges)
-            ranges[hit] = np.minimum(np.maximum(ranges[hit] + noise[hit], spec.range_min),
-                                     spec.range_max)             # np.clip, without its overhead
+            noisy = np.minimum(np.maximum(ranges + noise, spec.range_min), spec.range_max)
+            np.copyto(ranges, noisy, where=np.isfinite(ranges))    # returns only
         self._last = sim_time
         return LaserScanData(
             stamp=sim_time, frame_id=self.frame_id,

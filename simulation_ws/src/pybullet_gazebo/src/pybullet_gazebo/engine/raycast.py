@@ -349,9 +349,9 @@ class RayCaster:
         origin = np.asarray(origin, dtype=float).reshape(3)
         directions = np.asarray(directions, dtype=float).reshape(-1, 3)
         norms = np.sqrt((directions * directions) @ _ONES)
-        if not ((norms > 0.0).all() and np.isfinite(norms).all()):
+        directions = ray_kernel.unit_rows(directions, norms)
+        if directions is None:
             raise ValueError("RayCaster.cast: every direction must be a finite non-zero vector")
-        directions = directions / norms[:, None]
         range_min = max(0.0, float(range_min))
         range_max = float(range_max)
         result = np.full(len(directions), np.inf)

@@ -166,9 +166,10 @@ class World:
                         readings.append(Reading(robot, part, part.measure(now)))
                     else:
                         part.skip(now)
-            self.contacts.update(self.client, now, bodies, self._body_owner, self._grounds)
-            if touched is not None:
-                touched.update(self.contacts.touching())
+            if self.step_count > self._safe_until:    # (within it no robot touches a model)
+                self.contacts.update(self.client, now, bodies, self._body_owner, self._grounds)
+                if touched is not None:
+                    touched.update(self.contacts.touching())
             self._settled = self.layout_version
         return readings
 
@@ -179,11 +180,15 @@ class World:
             return 1                        # the contact guard said no for this stretch
         if self._settled != self.layout_version or not self.wrenches.idle():
             return 1                        # a teleport, spawn or delete: one step first
-        quiet = min([part.next_activity_time(now) for _, part in self._stepped[0]],
-                    default=math.inf)
-        k = 1
-        while k < most and k < MAX_BATCH and self.time_after(k) < quiet:
-            k += 1
+        quiet = math.inf
+        for _, part in self._stepped[0]:
+            quiet = min(quiet, part.next_activity_time(now))
+        # k steps may run when the k - 1 sim times between them come before `quiet`
+        k = min(most, MAX_BATCH)
+        if quiet < math.inf:
+            k = min(k, max(1, int((quiet - now) / self.step_size) + 2))
+        while k > 1 and not self.time_after(k - 1) < quiet:
+            k -= 1
         k = self._batcher.largest_exact(self.step_size, k)
         if k > 1 and self.step_count + k > self._safe_until:
             robots, others, grounds = self._guarded
