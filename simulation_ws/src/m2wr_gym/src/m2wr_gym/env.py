@@ -28,6 +28,12 @@ LOG = logging.getLogger("m2wr_gym")
 GOAL_RANGE = 30.0          # [m] bound of the goal's coordinates in the observation
 
 
+def _nearest(ranges):
+    """[m] the nearest laser return (inf when none)."""
+    finite = ranges[np.isfinite(ranges)]
+    return float(finite.min()) if len(finite) else math.inf
+
+
 class M2wrEnv(gymnasium.Env):
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
 
@@ -153,7 +159,7 @@ class M2wrEnv(gymnasium.Env):
         self._distance += math.hypot(after.x - before.x, after.y - before.y)
         self._path.append((after.x, after.y, after.yaw))
         pose0, pose1 = (before.x, before.y, before.yaw), (after.x, after.y, after.yaw)
-        nearest = float(np.min(np.where(np.isfinite(after.ranges), after.ranges, np.inf)))
+        nearest = _nearest(after.ranges)
         if self.options.task == "avoid":
             reward, terminated = tasks.avoid_reward(pose0, pose1, nearest, after.touched)
         else:
@@ -163,7 +169,7 @@ class M2wrEnv(gymnasium.Env):
         if terminated and after.touched and not self.options.end_on_contact:
             terminated = False
         truncated = not terminated and self._steps >= self.max_steps
-        return self._observe(), float(reward), terminated, truncated, self._info(command)
+        return self._observe(), float(reward), terminated, truncated, self._info(command, nearest)
 
     def _observe(self):
         s = self._snapshot
@@ -173,13 +179,12 @@ class M2wrEnv(gymnasium.Env):
             goal = np.clip(observation.goal_in_robot_frame(self._goal, s.x, s.y, s.yaw),
                            -GOAL_RANGE, GOAL_RANGE)
             return np.concatenate([laser, goal]).astype(np.float32)
-        return laser.astype(np.float32)
+        return laser.astype(np.float32, copy=False)      # (a new array already)
 
-    def _info(self, command):
+    def _info(self, command, nearest=None):
         s = self._snapshot
-        finite = s.ranges[np.isfinite(s.ranges)]
         info = {"sim_time": s.sim_time, "x": s.x, "y": s.y, "yaw": s.yaw,
-                "nearest": float(finite.min()) if len(finite) else math.inf,
+                "nearest": _nearest(s.ranges) if nearest is None else nearest,
                 "touched": s.touched, "distance": self._distance, "command": command}
         if self._goal is not None:
             info["goal"] = self._goal

@@ -36,7 +36,7 @@ def scan(ranges, range_max, downsample=1):
         raise ValueError("downsample=%d does not divide the scan's %d beams"
                          % (downsample, len(ranges)))
     ranges = np.where(np.isfinite(ranges), ranges, np.float32(range_max))
-    return ranges.reshape(-1, downsample).min(axis=1)
+    return ranges if downsample == 1 else ranges.reshape(-1, downsample).min(axis=1)
 
 
 def size(kind, downsample=1):
