@@ -215,15 +215,27 @@ def _index_windows(fan, n, low, high, windows):
 
 
 @njit(**_JIT)
-def _nearest_first(origin, position, bound):
-    """Shape indices by where their bounding spheres start, nearest first."""
+def _nearest_first(origin, kind, position, rotation, size, bound):
+    """(order, start): shape indices by how near the origin any of their points can be,
+    nearest first, and that distance [m] for each shape (a box's own distance from the
+    origin, 0 inside; else where its bounding sphere starts)."""
     start = np.empty(position.shape[0])
     for j in range(position.shape[0]):
         rx = position[j, 0] - origin[0]
         ry = position[j, 1] - origin[1]
         rz = position[j, 2] - origin[2]
-        start[j] = math.sqrt(rx * rx + ry * ry + rz * rz) - bound[j]
-    return np.argsort(start)
+        if kind is not None and kind[j] == BOX:
+            r = rotation[j]
+            gap = 0.0
+            for axis in range(3):
+                local = abs(r[0, axis] * rx + r[1, axis] * ry + r[2, axis] * rz) \
+                    - size[j, axis]
+                if local > 0.0:
+                    gap += local * local
+            start[j] = math.sqrt(gap)
+        else:
+            start[j] = math.sqrt(rx * rx + ry * ry + rz * rz) - bound[j]
+    return np.argsort(start), start
 
 
 @njit(**_JIT)
@@ -246,7 +258,10 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
     in_plane = plane_normal[0] != 0.0 or plane_normal[1] != 0.0 or plane_normal[2] != 0.0
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
-    order = _nearest_first(origin, position, bound) if culled else np.arange(kind.shape[0])
+    if culled:
+        order, start = _nearest_first(origin, kind, position, rotation, size, bound)
+    else:
+        order, start = np.arange(kind.shape[0]), np.zeros(0)
     for j in order:
         if body[j] == exclude_body:
             continue
@@ -270,9 +285,9 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
         count = _fan_windows(fan, kind[j], r, size[j], rx, ry, rz, distance2, reach + 1e-9,
                              directions.shape[0], windows) \
             if culled else _all_rays(directions.shape[0], windows)
-        # a fan's shapes come nearest first: a ray that already hit nearer than this shape's
-        # bounding sphere starts cannot hit it nearer (its own nearest is at least that far)
-        beyond = distance - reach - 1e-9 if culled else -math.inf
+        # a fan's shapes come nearest first: a ray that already hit nearer than any point of
+        # this shape cannot hit it nearer (1e-9 m for the rounding of that distance)
+        beyond = start[j] - 1e-9 if culled else -math.inf
         for w in range(count):
             for i in range(windows[w, 0], windows[w, 1] + 1):
                 if out[i] < beyond:
@@ -325,7 +340,10 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
     in_plane = plane_normal[0] != 0.0 or plane_normal[1] != 0.0 or plane_normal[2] != 0.0
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
-    order = _nearest_first(origin, position, bound) if culled else np.arange(position.shape[0])
+    if culled:
+        order, start = _nearest_first(origin, None, position, rotation, bound, bound)
+    else:
+        order, start = np.arange(position.shape[0]), np.zeros(0)
     for j in order:
         if body[j] == exclude_body:
             continue
@@ -348,7 +366,7 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
         windows_count = _fan_windows(fan, SPHERE, r, bound[j:j + 1], rx, ry, rz, distance2,
                                      reach + 1e-9, directions.shape[0], windows) \
             if culled else _all_rays(directions.shape[0], windows)
-        beyond = distance - reach - 1e-9 if culled else -math.inf     # as in nearest_hits
+        beyond = start[j] - 1e-9 if culled else -math.inf     # as in nearest_hits
         for w in range(windows_count):
             for i in range(windows[w, 0], windows[w, 1] + 1):
                 if out[i] < beyond:
