@@ -14,7 +14,7 @@ import numpy as np
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
-from pybullet_gazebo.engine.transforms import Pose
+from pybullet_gazebo.engine.transforms import Pose, yaw_from_quaternion
 from pybullet_gazebo.engine.world import SpawnError, World
 
 from . import resources
@@ -108,7 +108,7 @@ class InProcessSim:
                 self._laser_last = reading.data
         scan = self._laser_last
         pose = self.world.model_pose(ROBOT)
-        yaw = pose.rpy[2] if not callable(pose.rpy) else pose.rpy()[2]
+        yaw = yaw_from_quaternion(pose.orientation)
         return Snapshot(np.array(scan.ranges, dtype=np.float32), float(scan.range_max),
                         float(pose.position[0]), float(pose.position[1]), float(yaw),
                         float(self.world.sim_time), touched)

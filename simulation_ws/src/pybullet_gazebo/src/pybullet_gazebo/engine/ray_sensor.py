@@ -132,7 +132,8 @@ class RaySensor(Part):
         and the noise stream advance exactly as measure() would advance them."""
         spec = self.spec
         if spec.noise_stddev > 0.0 or spec.noise_mean != 0.0:
-            self.rng.normal(spec.noise_mean, spec.noise_stddev, len(self._beams))
+            # normal(mean, stddev, n) takes one standard normal draw per beam, as this does
+            self.rng.standard_normal(len(self._beams))
         self._last = sim_time
 
     def sensor_pose(self):
