@@ -620,3 +620,34 @@ def test_a_wrong_fan_hint_is_ignored(client):
     hinted = caster.cast((0, 0, 0), directions, 0.1, 10.0, fan=wrong)
     assert hinted.tobytes() == caster.cast((0, 0, 0), directions, 0.1, 10.0).tobytes()
     assert np.isfinite(hinted).sum() > 50
+
+
+def test_fan_hint_gives_the_same_ranges_on_meshes(client):
+    """Triangle meshes (a world model's mesh collisions) with and without the hint, beams
+    aimed through their vertices among others."""
+    rng = np.random.default_rng(11)
+    caster = RayCaster(client)
+    vertices = []
+    for index in range(12):
+        triangles = rng.uniform(-0.6, 0.6, size=(8, 3, 3))
+        centre = (rng.uniform(-6, 6), rng.uniform(-6, 6), rng.uniform(0.0, 0.4))
+        body = client.createMultiBody(0, client.createCollisionShape(
+            pybullet.GEOM_SPHERE, radius=0.01), basePosition=centre)
+        caster.add_body(body, static=True,
+                        base_shapes=[(pybullet.GEOM_MESH, triangles, (0.0, 0.0, 0.0),
+                                      (0.0, 0.0, 0.0, 1.0))])
+        vertices += list(triangles.reshape(-1, 3) + centre)
+    hits = 0
+    for trial in range(200):
+        origin = np.array([rng.uniform(-6, 6), rng.uniform(-6, 6), rng.uniform(0.0, 0.4)])
+        rotation = np.asarray(pybullet.getMatrixFromQuaternion(pybullet.getQuaternionFromEuler(
+            (rng.normal(0, 0.05), rng.normal(0, 0.05), rng.uniform(-3, 3))))).reshape(3, 3)
+        increment = math.pi / 719
+        angle_min = -math.pi / 2
+        if trial % 2:
+            local = rotation.T @ (vertices[rng.integers(len(vertices))] - origin)
+            angle_min = math.atan2(local[1], local[0]) - rng.integers(720) * increment
+        hinted, plain = _fan_scans(caster, origin, rotation, angle_min, increment, 720)
+        assert hinted.tobytes() == plain.tobytes(), trial
+        hits += np.isfinite(plain).sum()
+    assert hits > 200 * 720 * 0.05

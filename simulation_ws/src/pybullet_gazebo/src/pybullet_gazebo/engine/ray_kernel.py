@@ -49,6 +49,22 @@ def unit_rows(rows, norms):
 
 
 @njit(**_JIT)
+def fan_matches(fan, directions, tolerance):
+    """True when the first and last of `directions` are the fan's (see _fan_windows) within
+    `tolerance` in each coordinate, and the fan has a positive increment."""
+    if not fan[7] > 0.0:
+        return False
+    last = directions.shape[0] - 1
+    for index in (0, last):
+        angle = fan[6] + fan[7] * index
+        c, s = math.cos(angle), math.sin(angle)
+        for axis in range(3):
+            if not abs(c * fan[axis] + s * fan[3 + axis] - directions[index, axis]) <= tolerance:
+                return False
+    return True
+
+
+@njit(**_JIT)
 def _fmin(a, b):
     if a != a:
         return b
@@ -259,9 +275,9 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
     if culled:
-        order, start = _nearest_first(origin, kind, position, rotation, size, bound)
+        order, nearest = _nearest_first(origin, kind, position, rotation, size, bound)
     else:
-        order, start = np.arange(kind.shape[0]), np.zeros(0)
+        order, nearest = np.arange(kind.shape[0]), np.zeros(0)
     for j in order:
         if body[j] == exclude_body:
             continue
@@ -287,7 +303,7 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
             if culled else _all_rays(directions.shape[0], windows)
         # a fan's shapes come nearest first: a ray that already hit nearer than any point of
         # this shape cannot hit it nearer (1e-9 m for the rounding of that distance)
-        beyond = start[j] - 1e-9 if culled else -math.inf
+        beyond = nearest[j] - 1e-9 if culled else -math.inf
         for w in range(count):
             for i in range(windows[w, 0], windows[w, 1] + 1):
                 if out[i] < beyond:
@@ -341,9 +357,9 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
     if culled:
-        order, start = _nearest_first(origin, None, position, rotation, bound, bound)
+        order, nearest = _nearest_first(origin, None, position, rotation, bound, bound)
     else:
-        order, start = np.arange(position.shape[0]), np.zeros(0)
+        order, nearest = np.arange(position.shape[0]), np.zeros(0)
     for j in order:
         if body[j] == exclude_body:
             continue
@@ -366,7 +382,7 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
         windows_count = _fan_windows(fan, SPHERE, r, bound[j:j + 1], rx, ry, rz, distance2,
                                      reach + 1e-9, directions.shape[0], windows) \
             if culled else _all_rays(directions.shape[0], windows)
-        beyond = start[j] - 1e-9 if culled else -math.inf     # as in nearest_hits
+        beyond = nearest[j] - 1e-9 if culled else -math.inf     # as in nearest_hits
         for w in range(windows_count):
             for i in range(windows[w, 0], windows[w, 1] + 1):
                 if out[i] < beyond:
@@ -391,6 +407,8 @@ def warm_up():
     import time
     start = time.perf_counter()
     assert unit_rows(np.array([[3.0, 0.0, 4.0]]), np.array([5.0]))[0, 2] == 0.8
+    assert fan_matches(np.array([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, math.pi / 2]),
+                       np.eye(3)[:2].copy(), 1e-6)
     fan = np.array([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, math.pi / 2])   # rays at 0 and 90 deg
     for hint in (NO_FAN, fan):
         out = np.full(2, np.inf)

@@ -427,16 +427,9 @@ def _fan_array(fan, directions):
     """The kernels' fan (8,) for a cast's hint, checked on the first and last (unit)
     directions; the kernels' NO_FAN when the hint does not describe them."""
     x_axis, y_axis, angle_min, increment = fan
-    x0, x1, x2 = (float(c) for c in x_axis)
-    y0, y1, y2 = (float(c) for c in y_axis)
-    angle_min, increment = float(angle_min), float(increment)
-    if not increment > 0.0:
-        return ray_kernel.NO_FAN
-    last = angle_min + increment * (len(directions) - 1)
-    for angle, (d0, d1, d2) in ((angle_min, directions[0].tolist()),
-                                (last, directions[-1].tolist())):
-        c, s = math.cos(angle), math.sin(angle)
-        if not (abs(c * x0 + s * y0 - d0) <= _FAN_CHECK and abs(c * x1 + s * y1 - d1)
-                <= _FAN_CHECK and abs(c * x2 + s * y2 - d2) <= _FAN_CHECK):
-            return ray_kernel.NO_FAN
-    return np.array([x0, x1, x2, y0, y1, y2, angle_min, increment])
+    array = np.empty(8)
+    array[0:3] = x_axis
+    array[3:6] = y_axis
+    array[6] = angle_min
+    array[7] = increment
+    return array if ray_kernel.fan_matches(array, directions, _FAN_CHECK) else ray_kernel.NO_FAN
