@@ -24,7 +24,7 @@ CSV_FIELDS = [
     "simulator_rss_mib", "bag", "picture", "path",
 ]
 MACHINE_FIELDS = {"wall_time_s", "real_time_factor", "overhead_s", "worker", "worker_rss_mib",
-                  "simulator_rss_mib", "zygote_rss_mib", "reused", "controller_log", "bag", "picture", "stages", "finished_at",
+                  "simulator_rss_mib", "zygote_rss_mib", "reused", "controller_log", "bag", "picture", "stages", "cpu_s", "finished_at",
                   "cmd_vel_messages", "cases_s",
                   "controller_exit"}
 

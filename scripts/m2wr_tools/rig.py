@@ -51,7 +51,7 @@ from .names import (BASE_FRAME, COMMAND_TOPIC, CONTACTS_TOPIC, ODOM_TOPIC, PAUSE
                     RESET_SIMULATION_SERVICE, ROBOT, SCAN_TOPIC, SIMULATOR_NODE, TF_TOPIC,
                     UNPAUSE_SERVICE)
 from .scenarios import Scenario
-from .session import Session, SessionError
+from .session import Session, SessionError, python_logging_config
 
 NODE = "/m2wr_batch"
 SPAWN_Z = 0.5                 # [m] spawn.launch's default drop height of link_chassis
@@ -110,6 +110,9 @@ class Rig:
         except SessionError:
             session.stop_all()
             raise
+        config = python_logging_config(session.env)
+        if config:
+            session.env["ROS_PYTHON_LOG_CONFIG_FILE"] = config
         self.session = session
         os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
         os.environ.pop("ROS_IP", None)
@@ -178,10 +181,12 @@ class Rig:
         os.makedirs(runs_dir, exist_ok=True)
         log_path = os.path.join(runs_dir, scenario.run_id + ".log")
         record.update(controller_log=log_path, controller_exit=None, reused=False)
+        meter = None
         try:
             self._ensure_master(options)
             record["reused"] = self._ensure_simulator(scenario, options)
-            record.update(self._run(scenario, options, log_path, runs_dir))
+            meter = self._cpu_meter()
+            record.update(self._run(scenario, options, log_path, runs_dir, meter))
         except RunFailed as err:
             record.update(success=False, reason=str(err))
             self.key = None       # the loop may still wait for that controller: relaunch
@@ -196,6 +201,9 @@ class Rig:
             record["controller_exit"] = self._stop_controller(record.get("controller_exit"))
             if isinstance(record.get("stages"), dict):
                 record["stages"]["stop_s"] = round(time.monotonic() - stopping, 3)
+            if meter is not None:
+                meter.mark("stop_s")
+                record["cpu_s"] = {"total": meter.totals(), "stages": meter.stages}
         record["wall_time_s"] = time.monotonic() - wall0
         record["finished_at"] = time.time()
         sim = record.get("sim_time_s") or 0.0
@@ -221,7 +229,28 @@ class Rig:
             return known_exit
         return report.get("controller", known_exit)
 
-    def _run(self, scenario, options, log_path, runs_dir):
+    def _cpu_meter(self):
+        """CPU of the run's processes (see m2wr_tools.cpu_meter): this worker (with the
+        children it reaped: controllers started as plain processes), the simulator node, its
+        roslaunch, the master, the controller while it runs, and the zygote with the
+        controllers it has reaped (their whole CPU, their exit included)."""
+        from .cpu_meter import CpuMeter
+
+        def child(name):
+            def pid():
+                found = self.session.child(name) if self.session is not None else None
+                return found.pid if found is not None else None
+            return pid
+        return CpuMeter({
+            "worker": (os.getpid, True),
+            "simulator": (lambda: self.simulator_pid, False),
+            "roslaunch": (child("world"), False),
+            "master": (child("roscore"), False),
+            "controller": (child("controller"), False),
+            "zygote": (lambda: self.zygote.process.pid if self.zygote else None, True),
+        })
+
+    def _run(self, scenario, options, log_path, runs_dir, meter):
         import rospy
         from .recorder import Recorder
         session = self.session
@@ -231,6 +260,7 @@ class Rig:
             now = time.monotonic()
             stages[name] = round(now - mark[0], 3)
             mark[0] = now
+            meter.mark(name)
         self.services.empty(PAUSE_SERVICE)
         self.services.empty(RESET_SIMULATION_SERVICE)
         self.services.set_model_pose(ROBOT, scenario.x, scenario.y, SPAWN_Z, scenario.yaw)
@@ -341,17 +371,22 @@ class Rig:
             time.sleep(0.02)
         raise SessionError("%s within %.0f s" % (what, timeout))
 
-    def _wait_for_controller(self, controller, timeout, log_path, settle=0.3, idle=0.1):
+    def _wait_for_controller(self, controller, timeout, log_path, settle=0.3, idle=0.1,
+                             poll=0.02, poll_spinning=0.005):
         """Until a node other than the batch's publishes cmd_vel to the simulator, and every
         topic of the simulator it subscribes to is connected, unchanged for `settle` [s]
         (a program may subscribe after it advertises, as obstacle_avoidance.py does) - or
         for `idle` [s] during which the controller used no CPU at all, when that node is
-        the controller's own process (it has finished starting and waits for messages)."""
+        the controller's own process (it has finished starting and waits for messages) -
+        or at once when the controller, forked from the zygote, has entered rospy.spin()
+        (its main thread has made every subscription: m2wr_tools.warm_rospy)."""
         master = self.session.master()
         deadline = time.monotonic() + timeout
         ready_since, last = None, None
         own, cpu, idle_since = None, None, None
+        spinning = getattr(controller, "spinning", None)
         while time.monotonic() < deadline:
+            spun = spinning is not None and spinning(poll)      # an event wait, not a sleep
             if not controller.running():
                 raise RunFailed("controller exited with status %s while starting; see %s:\n%s"
                                 % (controller.returncode, log_path, controller.log_tail(8)))
@@ -367,6 +402,8 @@ class Rig:
             ready = any(self.session.connected(SIMULATOR_NODE, COMMAND_TOPIC, n) for n in nodes) \
                 and all(self.session.connected(SIMULATOR_NODE, t, n) for n, t in wanted)
             now = time.monotonic()
+            if ready and spun:
+                return
             if ready and wanted == last:
                 if ready_since is None:
                     ready_since = now
@@ -381,7 +418,8 @@ class Rig:
             else:
                 ready_since, own, cpu, idle_since = None, None, None, None
             last = wanted
-            time.sleep(0.02)
+            if spinning is None or spun:
+                time.sleep(poll_spinning if spun else poll)
         raise RunFailed("the controller published no %s within %.0f s of wall time (it is "
                         "running; see %s)" % (COMMAND_TOPIC, timeout, log_path))
 

