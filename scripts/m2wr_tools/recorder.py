@@ -9,7 +9,9 @@ Topics in:
   /m2wr/laser/scan (sensor_msgs/LaserScan)   only over the run's last `scan_window` seconds
                                              of sim time: the last scan, and a count
   /rosout (rosgraph_msgs/Log)                obstacle_avoidance.py's case lines (node
-                                             /reading_laser): (stamp, text)
+                                             /reading_laser): (stamp, text); not with
+                                             cases_from_rosout=False (the batch runner
+                                             reads them from the controller's log file)
   /gazebo/contacts (gazebo_msgs/ContactsState)  each set of (robot, model) pairs in contact
 
 The loop being measured pays for every connection its publishers serve, so the demo keeps
@@ -35,13 +37,15 @@ from .names import (CONTACTS_TOPIC, CONTROLLER_NODE, ODOM_TOPIC, ROSOUT_TOPIC, S
 class Recorder:
     """Collects a run's data. Construct with subscribe=False to feed callbacks by hand."""
 
-    def __init__(self, subscribe=True, scan_window=3.0, poses_from_tf=None):
+    def __init__(self, subscribe=True, scan_window=3.0, poses_from_tf=None,
+                 cases_from_rosout=True):
         self.sim_time = None               # [s] latest odometry stamp
         self.poses = []                    # (t, x, y, z, qx, qy, qz, qw)
         self.last_scan = None              # sensor_msgs/LaserScan
         self.scans = 0
         self.cases = []                    # (t, text) of the controller's case lines
         self.contacts = []                 # (t, [(robot, model), ...])
+        self.contact_messages = 0          # heard since the subscription (restart keeps it)
         self.scan_window = scan_window     # [s] of sim time before the target
         self._subscribe = subscribe
         self._target = None
@@ -55,7 +59,8 @@ class Recorder:
                 sub(rospy.Subscriber(TF_TOPIC, TFMessage, self.on_tf, queue_size=1000))
             else:
                 sub(rospy.Subscriber(ODOM_TOPIC, Odometry, self.on_odom, queue_size=1000))
-            sub(rospy.Subscriber(ROSOUT_TOPIC, Log, self.on_log, queue_size=1000))
+            if cases_from_rosout:
+                sub(rospy.Subscriber(ROSOUT_TOPIC, Log, self.on_log, queue_size=1000))
             sub(rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self.on_contacts,
                                  queue_size=100))
 
@@ -123,6 +128,7 @@ class Recorder:
     def on_contacts(self, msg):
         pairs = [(s.collision1_name, s.collision2_name) for s in msg.states]
         self.contacts.append((msg.header.stamp.to_sec(), pairs))
+        self.contact_messages += 1
 
     # --- views --------------------------------------------------------------------------
     def current_case(self):

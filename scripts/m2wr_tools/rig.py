@@ -42,6 +42,7 @@ import socket
 import subprocess
 import threading
 import time
+import xmlrpc.client
 
 import numpy as np
 
@@ -57,8 +58,9 @@ NODE = "/m2wr_batch"
 SPAWN_Z = 0.5                 # [m] spawn.launch's default drop height of link_chassis
 PATH_PERIOD = 0.5             # [s] sim: the path kept in the results
 CLEARANCE_PERIOD = 0.1        # [s] sim: poses whose clearance is measured
-LAST_MESSAGES = 0.2           # [s] wall after the pause by which the run's last messages
-                              # (contacts, cmd_vel) have arrived; the track is measured meanwhile
+LAST_MESSAGES = 0.5           # [s] wall after the pause by which the run's last contacts
+                              # messages have arrived, when the simulator cannot say how many
+                              # it sent (see Rig._simulator_counts)
 BATCH_TAG = "M2WR_BATCH"      # environment variable naming the batch every child belongs to
 
 
@@ -89,7 +91,7 @@ class Rig:
         self.simulator_pid = None
         self.recorder = None
         self.commands = 0
-        self._command_sub = None
+        self._recorder_connected = None   # simulator pid the recorder was seen connected to
         self.scenes = {}              # world -> scene.Scene (offline geometry)
         self.zygote = None            # zygote.Zygote of this session (warm Python controllers)
         self.services = Services()    # the simulator's services, connections kept between runs
@@ -117,13 +119,33 @@ class Rig:
         os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
         os.environ.pop("ROS_IP", None)
         import rospy
-        from geometry_msgs.msg import Twist
         rospy.init_node(NODE.lstrip("/"), disable_signals=True)
-        self._command_sub = rospy.Subscriber(COMMAND_TOPIC, Twist, self._on_command,
-                                             queue_size=100, tcp_nodelay=True)
 
-    def _on_command(self, _msg):
-        self.commands += 1
+    def _simulator_counts(self):
+        """(cmd_vel messages the simulator has received from the publishers connected now,
+        /gazebo/contacts messages it has written to the recorder), from its node's
+        getBusStats and getBusInfo (XML-RPC; no subscription of the batch's to /cmd_vel
+        costs the controller a second connection). (None, None) when it does not answer."""
+        uri = self.session.node_uri(SIMULATOR_NODE)
+        if uri is None:
+            return None, None
+        node = xmlrpc.client.ServerProxy(uri)
+        try:
+            code, _, (published, subscribed, _) = node.getBusStats(NODE)
+            code_info, _, bus = node.getBusInfo(NODE)
+        except (OSError, xmlrpc.client.Error, ValueError):
+            return None, None
+        if code != 1 or code_info != 1:
+            return None, None
+        # getBusStats: [topic, [[connection id, bytes, messages, drops, connected], ...]] for
+        # subscriptions; [topic, bytes, [[connection id, bytes, messages, connected], ...]]
+        # for publications. getBusInfo: [connection id, peer, direction, transport, topic, ...]
+        commands = sum(c[2] for topic, connections in subscribed if topic == COMMAND_TOPIC
+                       for c in connections)
+        ours = {c[0] for c in bus if len(c) >= 5 and c[4] == CONTACTS_TOPIC and c[1] == NODE}
+        contacts = [c[2] for topic, _, connections in published if topic == CONTACTS_TOPIC
+                    for c in connections if c[0] in ours]
+        return commands, (contacts[0] if len(contacts) == 1 else None)
 
     def _ensure_simulator(self, scenario, options):
         """True when the running simulator is reused; else (re)launches it."""
@@ -199,6 +221,8 @@ class Rig:
         finally:
             stopping = time.monotonic()
             record["controller_exit"] = self._stop_controller(record.get("controller_exit"))
+            if "distance_m" in record:          # measured: the controller's lines are all out
+                record["cases_s"] = _case_shares(log_path, scenario.duration)
             if isinstance(record.get("stages"), dict):
                 record["stages"]["stop_s"] = round(time.monotonic() - stopping, 3)
             if meter is not None:
@@ -271,14 +295,17 @@ class Rig:
                 rospy.set_param("/" + name, float(value))
         # One recorder for the rig's life: its connections stay up between runs, and a
         # latched /gazebo/contacts message of an earlier run never reaches a new one.
+        # The case lines come from the controller's log file, not /rosout: with no
+        # subscriber, its rospy publishes no Log message (600 a wall second at 30x).
         if self.recorder is None:
-            self.recorder = Recorder(poses_from_tf=BASE_FRAME)
+            self.recorder = Recorder(poses_from_tf=BASE_FRAME, cases_from_rosout=False)
         recorder = self.recorder
         recorder.restart()
-        self.commands = 0
-        self._wait(lambda: session.connected(SIMULATOR_NODE, TF_TOPIC, NODE)
-                   and session.connected(SIMULATOR_NODE, CONTACTS_TOPIC, NODE), 10.0,
-                   "the batch's recorder did not connect to the simulator")
+        if self._recorder_connected != self.simulator_pid:
+            self._wait(lambda: session.connected(SIMULATOR_NODE, TF_TOPIC, NODE)
+                       and session.connected(SIMULATOR_NODE, CONTACTS_TOPIC, NODE), 10.0,
+                       "the batch's recorder did not connect to the simulator")
+            self._recorder_connected = self.simulator_pid
         stage("reset_s")
         controller = self._start_controller(self._resolve(scenario.controller), log_path,
                                             options.warm_start)
@@ -312,6 +339,7 @@ class Rig:
         self.services.empty(PAUSE_SERVICE)
         paused_at = time.monotonic()
         unpaused = paused_at - start
+        commands, contacts_sent = self._simulator_counts()
         stage("sim_s")
         exit_status = None
         if not controller.running():
@@ -323,10 +351,15 @@ class Rig:
             controller.signal_group(signal.SIGINT)     # it ends while the run is measured
 
         def settled():
-            """The messages sent before the pause have arrived (contacts, cmd_vel counts:
-            other connections than /tf's, which `reached` waited for)."""
-            time.sleep(max(0.0, paused_at + LAST_MESSAGES - time.monotonic()))
+            """Every /gazebo/contacts message the simulator sent to the recorder before the
+            pause has been heard (/tf's, the track, are in: `reached` waited for them); at
+            most LAST_MESSAGES [s] of wall time after the pause when the count is unknown."""
+            deadline = paused_at + LAST_MESSAGES
+            while (contacts_sent is None or recorder.contact_messages < contacts_sent) \
+                    and time.monotonic() < deadline:
+                time.sleep(0.002)
         result = self._measure(scenario, recorder, options, runs_dir, settled)
+        self.commands = commands or 0
         if outcome is None and self.commands == 0:
             outcome = "the controller never published on %s; see %s" % (COMMAND_TOPIC, log_path)
         stage("measure_s")
@@ -475,7 +508,6 @@ class Rig:
             "final_yaw": float(track[-1, 3]),
             "path": [[round(float(t), 3), round(float(x), 4), round(float(y), 4)]
                      for t, x, y in path[:, :3]],
-            "cases_s": _case_shares(recorder.cases, duration),
         }
         if options.bag:
             result["bag"] = os.path.join(runs_dir, scenario.run_id + ".bag")
@@ -518,9 +550,15 @@ class Rig:
             self.session = None
 
 
-def _case_shares(cases, duration):
-    from .summary import case_durations
-    return case_durations(cases, 0.0, duration)
+def _case_shares(log_path, duration):
+    """{case: sim seconds} of obstacle_avoidance.py's case lines in the controller's log
+    (rospy prints each with its sim time), {} for a controller that prints none."""
+    from .summary import case_durations, case_lines
+    try:
+        with open(log_path, encoding="utf-8", errors="replace") as log:
+            return case_durations(case_lines(log.read()), 0.0, duration)
+    except OSError:
+        return {}
 
 
 # --- the Dask task --------------------------------------------------------------------

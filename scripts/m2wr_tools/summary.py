@@ -21,6 +21,21 @@ def is_case(text):
     return bool(_CASE.match(text.strip()))
 
 
+# a rospy log line on a node's stdout with sim time: "[INFO] [<wall s>, <sim s>]: <text>"
+_LOG_LINE = re.compile(r"^\[\s*[A-Z]+\s*\]\s*\[\s*[0-9.]+\s*,\s*([0-9.]+)\s*\]:\s?(.*)$")
+
+
+def case_lines(text):
+    """(sim time [s], text) of obstacle_avoidance.py's case lines in a node's output, as
+    rospy prints them with sim time (its default format, no ROSCONSOLE_FORMAT)."""
+    found = []
+    for line in text.splitlines():
+        match = _LOG_LINE.match(line)
+        if match and is_case(match.group(2)):
+            found.append((float(match.group(1)), match.group(2).strip()))
+    return found
+
+
 def _case_order(name):
     match = re.match(r"case (\d+)", name)
     return (0, int(match.group(1)), name) if match else (1, 0, name)
