@@ -220,12 +220,13 @@ def bench(args):
                                     "reuse" if reuse else "relaunch")
         out = os.path.join(args.output, "bench", "w%d_%s" % (workers, "reuse" if reuse else "relaunch"))
         say("bench: %s, %d runs of %g s" % (name, len(scenarios), args.duration))
-        t = time.monotonic()
+        t, driver = time.monotonic(), os.times()
         records = run_batch(scenarios, RunOptions(output=out, reuse=reuse,
                                                   warm_start=not args.cold_start),
                             workers=workers, resume=False, progress=not args.no_progress,
                             say=say)
         wall = time.monotonic() - t
+        driver = (os.times().user + os.times().system - driver.user - driver.system)
         overheads = [r["overhead_s"] / r["wall_time_s"] for r in records
                      if r.get("overhead_s") is not None and r.get("reused")]
         figures[name] = {"runs": len(records), "wall_s": wall,
@@ -236,6 +237,8 @@ def bench(args):
                              [r["overhead_s"] for r in records if r.get("overhead_s") is not None
                               and r.get("reused")] or [math.nan]),
                          "stages_median": _stage_medians(records),
+                         "cpu_median": _cpu_medians(records),
+                         "driver_cpu_s_per_run": driver / max(1, len(records)),
                          "memory": _memory(records)}
         say("  %.2f runs/min" % figures[name]["runs_per_min"])
     print("\nbatch benchmark: %d runs of %g s sim (world02, obstacle_avoidance.py, lockstep, "
@@ -252,6 +255,17 @@ def bench(args):
         if f["stages_median"] and "reuse" in name:
             print("  stages %-22s %s (median s; overhead = all but sim)" % (name, "  ".join(
                 "%s %.3f" % (k[:-2], v) for k, v in f["stages_median"].items())))
+    for name, f in figures.items():
+        if f["cpu_median"] and "reuse" in name:
+            cpu = f["cpu_median"]
+            print("  cpu %-25s %s  driver (scheduler, client) %.2f  = %.2f s a run (median "
+                  "CPU s; the controller with its exit)" % (name, "  ".join(
+                      "%s %.2f" % (k, v) for k, v in cpu["per_run"].items()),
+                      f["driver_cpu_s_per_run"],
+                      sum(cpu["per_run"].values()) + f["driver_cpu_s_per_run"]))
+            print("  cpu %-25s while stepping: %s = %.2f cores over sim's wall time" % (
+                "", "  ".join("%s %.2f" % (k, v) for k, v in cpu["stepping"].items()),
+                cpu["stepping_cores"]))
     for mode in ("reuse", "relaunch"):
         one, two = figures["1 worker, %s" % mode], figures["2 workers, %s" % mode]
         print("  speed-up 2 vs 1 worker, %-8s %.2fx" % (mode, two["runs_per_min"] / one["runs_per_min"]))
@@ -272,6 +286,31 @@ def _stage_medians(records):
     names = [n for n in ("reset_s", "controller_start_s", "sim_s", "measure_s", "stop_s")
              if any(n in s for s in stages)]
     return {n: statistics.median([s[n] for s in stages if n in s]) for n in names}
+
+
+def _cpu_medians(records):
+    """Median CPU [s] a run of each process (rig's cpu_s; the controller is the zygote's
+    figure, its children's exits included), the CPU while physics stepped (stage sim_s),
+    and the cores that used over sim_s's wall time, over the runs with reuse."""
+    runs = [r for r in records if r.get("reused") and r.get("cpu_s") and r.get("stages")]
+    if not runs:
+        return {}
+
+    def per_run(r):
+        total = dict(r["cpu_s"]["total"])
+        zygote, live = total.pop("zygote", None), total.pop("controller", 0.0)
+        total["controller"] = zygote if zygote is not None else live
+        return total
+    names = ("simulator", "controller", "worker", "master", "roslaunch")
+    stepping = [r["cpu_s"]["stages"].get("sim_s", {}) for r in runs]
+    return {
+        "per_run": {n: statistics.median([per_run(r).get(n, 0.0) for r in runs]) for n in names},
+        "stepping": {n: statistics.median([s.get(n, 0.0) for s in stepping])
+                     for n in ("simulator", "controller", "worker", "master")},
+        "stepping_cores": statistics.median([sum(s.values()) / r["stages"]["sim_s"]
+                                             for s, r in zip(stepping, runs)
+                                             if r["stages"].get("sim_s")]),
+    }
 
 
 def bench_memory(args):
