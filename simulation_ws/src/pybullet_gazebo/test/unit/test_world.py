@@ -275,3 +275,21 @@ def test_the_laser_sees_a_static_model_where_set_model_state_put_it(make_world, 
     assert world.entity("jersey_barrier").static
     world.set_model_state("jersey_barrier", Pose.from_xyz_rpy(-4.0, 2.0, 0.0, 0, 0, math.pi / 2))
     assert 1.2 < laser.measure(world.sim_time).ranges[ahead] < 2.0
+
+
+def test_reset_world_puts_moved_static_models_back_where_the_laser_sees_them(make_world):
+    """reset_world refreshes the ray caster's static shapes once for all models; a static
+    model moved away is hit again at its initial place."""
+    world = make_world("world02")
+    name, entity = next((n, e) for n, e in world.entities.items()
+                        if e.static and not e.is_ground)
+    x, y, _ = world.model_pose(name).position
+    down = np.array([[0.0, 0.0, -1.0]])
+
+    def height_below(px, py):
+        return world.caster.cast((px, py, 20.0), down, 0.0, 40.0)[0]
+    seen = height_below(x, y)
+    world.set_model_state(name, Pose((x + 50.0, y + 50.0, 0.0)))
+    assert height_below(x, y) > seen + 1e-3          # gone from there
+    world.reset_world()
+    assert height_below(x, y) == pytest.approx(seen, abs=1e-9)
