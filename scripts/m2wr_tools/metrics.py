@@ -103,18 +103,30 @@ def contact_figures(updates: Sequence[Tuple[float, Sequence]], duration):
 def stuck_time(track, window=5.0, radius=0.2):
     """Sim time [s] the robot spent stuck: a stretch between two samples counts when every
     position of the `window` [s] before its end lies within `radius` [m] of that end (it may
-    turn on the spot or rock; it does not get anywhere). track: (n, >=3) t, x, y."""
+    turn on the spot or rock; it does not get anywhere). track: (n, >=3) t, x, y, in time
+    order. Every window at once: (samples x longest window) distances, in chunks."""
     track = np.asarray(track, dtype=float)
-    total, start = 0.0, 0
-    for i in range(1, len(track)):
-        t = track[i, 0]
-        if t - track[0, 0] < window - 1e-9:
-            continue
-        while track[start, 0] < t - window - 1e-9:
-            start += 1
-        span = track[start:i + 1, 1:3] - track[i, 1:3]
-        if np.max(np.hypot(span[:, 0], span[:, 1])) <= radius:
-            total += t - track[i - 1, 0]
+    if len(track) < 2:
+        return 0.0
+    t, xy = track[:, 0], track[:, 1:3]
+    ends = np.nonzero(t - t[0] >= window - 1e-9)[0]
+    ends = ends[ends >= 1]
+    if not len(ends):
+        return 0.0
+    starts = np.searchsorted(t, t[ends] - window - 1e-9, side="left")
+    longest = int((ends - starts).max()) + 1
+    stuck = np.zeros(len(ends), dtype=bool)
+    chunk = max(1, 2_000_000 // longest)
+    for a in range(0, len(ends), chunk):
+        end, start = ends[a:a + chunk], starts[a:a + chunk]
+        index = end[:, None] - np.arange(longest)[None, :]       # the end first, back in time
+        inside = index >= start[:, None]
+        span = xy[np.maximum(index, 0)] - xy[end][:, None, :]
+        far = np.hypot(span[..., 0], span[..., 1]) > radius
+        stuck[a:a + chunk] = ~(far & inside).any(axis=1)
+    total = 0.0
+    for i in ends[stuck]:                 # summed in time order, as sample by sample
+        total += t[i] - t[i - 1]
     return float(total)
 
 
