@@ -7,7 +7,8 @@ Topics in:
                                              the odom -> BASE_FRAME transform (the batch runner:
                                              /tf's publisher drops nothing under load)
   /m2wr/laser/scan (sensor_msgs/LaserScan)   only over the run's last `scan_window` seconds
-                                             of sim time: the last scan, and a count
+                                             of sim time: the last scan, and a count; never
+                                             with scan_window=None (the batch runner)
   /rosout (rosgraph_msgs/Log)                obstacle_avoidance.py's case lines (node
                                              /reading_laser): (stamp, text); not with
                                              cases_from_rosout=False (the batch runner
@@ -46,7 +47,7 @@ class Recorder:
         self.cases = []                    # (t, text) of the controller's case lines
         self.contacts = []                 # (t, [(robot, model), ...])
         self.contact_messages = 0          # heard since the subscription (restart keeps it)
-        self.scan_window = scan_window     # [s] of sim time before the target
+        self.scan_window = scan_window     # [s] of sim time before the target, or None
         self._subscribe = subscribe
         self._target = None
         self._scan_sub = None
@@ -91,8 +92,8 @@ class Recorder:
     def _tick(self):
         if self._target is None or self.sim_time is None:
             return
-        if self.sim_time >= self._target - self.scan_window and self._scan_sub is None \
-                and self._subscribe:
+        if self.scan_window is not None and self._scan_sub is None and self._subscribe \
+                and self.sim_time >= self._target - self.scan_window:
             self._scan_sub = rospy.Subscriber(SCAN_TOPIC, LaserScan, self.on_scan, queue_size=1)
         if self.sim_time >= self._target:
             self.reached.set()

@@ -26,7 +26,7 @@ CSV_FIELDS = [
 MACHINE_FIELDS = {"wall_time_s", "real_time_factor", "overhead_s", "worker", "worker_rss_mib",
                   "simulator_rss_mib", "zygote_rss_mib", "reused", "controller_log", "bag", "picture", "stages", "cpu_s", "finished_at",
                   "cmd_vel_messages", "cases_s",
-                  "controller_exit"}
+                  "controller_exit", "controller_stop"}
 
 
 def load(folder):

@@ -11,20 +11,27 @@ depends only on its scenario:
   the recorder restarted (one per rig: its connections stay up) -> the controller started
   (a Python script is forked from the session's warm zygote, m2wr_tools.zygote; anything
   else is a plain process) and publishing cmd_vel -> physics unpaused for `duration` s of
-  sim time -> paused -> the controller sent SIGINT while the run is measured -> its exit
-  awaited (the next run's reset comes after it: none of its commands can reach that run).
+  sim time -> paused -> the controller sent SIGINT while the run is measured (the record's
+  controller_stop says so; a zygote's rospy program ends ~0.1 s later, m2wr_tools.warm_rospy)
+  -> its exit awaited (the next run's reset comes after it: none of its commands can reach
+  that run).
 
 Per-run `stages` [s wall] in the record: reset_s, controller_start_s, sim_s, measure_s,
-stop_s; `overhead_s` = the run's wall time less sim_s's unpaused part.
+stop_s; `overhead_s` = the run's wall time less sim_s's unpaused part; `cpu_s`: the CPU [s]
+of each process of the worker (this one, the simulator, its roslaunch, the master, the
+controller) per stage and in total (m2wr_tools.cpu_meter).
 
 The simulator is kept between runs of the same world and seed (reuse) and relaunched
 otherwise (the seed is a launch argument), or before every run with reuse off. The world and
 seed of a relaunch are the run's; the robot is spawned with spawn.launch once per launch.
 
 Topics in (the recorder): /tf (odom -> link_chassis: the trajectory; /odom's publisher keeps
-one message and drops under load, /tf's queues), /gazebo/contacts, /rosout_agg, /cmd_vel
-(answers counted). The simulator runs with lockstep_timeout 30 s (wall) instead of 1 s, so
-that a loaded machine cannot make it step on without the controller's answer.
+one message and drops under load, /tf's queues) and /gazebo/contacts; nothing else, as each
+connection costs the loop being measured. The controller's case lines are read from its
+log (rospy prints each with its sim time), the cmd_vel messages counted from the
+simulator's getBusStats at the pause. The simulator runs with lockstep_timeout 30 s (wall)
+instead of 1 s, so that a loaded machine cannot make it step on without the controller's
+answer.
 ROS params set for the controller: des_pos_x, des_pos_y, initial_x, initial_y [m] (the
 series' go_to_point/bug names) when the task is `goal`.
 
@@ -296,9 +303,11 @@ class Rig:
         # One recorder for the rig's life: its connections stay up between runs, and a
         # latched /gazebo/contacts message of an earlier run never reaches a new one.
         # The case lines come from the controller's log file, not /rosout: with no
-        # subscriber, its rospy publishes no Log message (600 a wall second at 30x).
+        # subscriber, its rospy publishes no Log message (600 a wall second at 30x). No
+        # scans either (the run's metrics need none).
         if self.recorder is None:
-            self.recorder = Recorder(poses_from_tf=BASE_FRAME, cases_from_rosout=False)
+            self.recorder = Recorder(poses_from_tf=BASE_FRAME, cases_from_rosout=False,
+                                     scan_window=None)
         recorder = self.recorder
         recorder.restart()
         if self._recorder_connected != self.simulator_pid:
@@ -341,7 +350,7 @@ class Rig:
         unpaused = paused_at - start
         commands, contacts_sent = self._simulator_counts()
         stage("sim_s")
-        exit_status = None
+        exit_status = stopped = None
         if not controller.running():
             exit_status = "exit %s" % controller.returncode
         else:
@@ -349,6 +358,7 @@ class Rig:
             # answer (a pause ends that wait), and the next run's reset forgets the awaited
             # answer and the drive's command; the controller may stop at once.
             controller.signal_group(signal.SIGINT)     # it ends while the run is measured
+            stopped = "SIGINT from the runner at the end of its run"
 
         def settled():
             """Every /gazebo/contacts message the simulator sent to the recorder before the
@@ -366,6 +376,7 @@ class Rig:
         result["stages"] = stages
         result["_unpaused_wall_s"] = unpaused
         result["cmd_vel_messages"] = self.commands
+        result["controller_stop"] = stopped
         if exit_status is not None:
             result["controller_exit"] = exit_status
         if outcome is not None:
