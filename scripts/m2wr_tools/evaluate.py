@@ -238,6 +238,7 @@ def bench(args):
                               and r.get("reused")] or [math.nan]),
                          "stages_median": _stage_medians(records),
                          "cpu_median": _cpu_medians(records),
+                         "steady_runs_per_min": _steady_rate(records),
                          "driver_cpu_s_per_run": driver / max(1, len(records)),
                          "memory": _memory(records)}
         say("  %.2f runs/min" % figures[name]["runs_per_min"])
@@ -268,7 +269,12 @@ def bench(args):
                 cpu["stepping_cores"]))
     for mode in ("reuse", "relaunch"):
         one, two = figures["1 worker, %s" % mode], figures["2 workers, %s" % mode]
-        print("  speed-up 2 vs 1 worker, %-8s %.2fx" % (mode, two["runs_per_min"] / one["runs_per_min"]))
+        steady = "" if not (one["steady_runs_per_min"] and two["steady_runs_per_min"]) else \
+            "   (after each worker's first run: %.1f and %.1f runs/min, %.2fx)" % (
+                one["steady_runs_per_min"], two["steady_runs_per_min"],
+                two["steady_runs_per_min"] / one["steady_runs_per_min"])
+        print("  speed-up 2 vs 1 worker, %-8s %.2fx%s" % (
+            mode, two["runs_per_min"] / one["runs_per_min"], steady))
     for name, f in figures.items():
         for worker, m in f["memory"].items():
             print("  memory %-22s %s: worker %s MiB, simulator %s MiB (first -> last of %d runs)"
@@ -286,6 +292,19 @@ def _stage_medians(records):
     names = [n for n in ("reset_s", "controller_start_s", "sim_s", "measure_s", "stop_s")
              if any(n in s for s in stages)]
     return {n: statistics.median([s[n] for s in stages if n in s]) for n in names}
+
+
+def _steady_rate(records):
+    """Runs per wall minute once the workers are up: each worker's runs after its first
+    (which carries the start of its master, simulator and zygote) over the wall time from
+    its first run's end to its last's, summed over the workers; None with too few runs."""
+    ends = {}
+    for r in records:
+        if r.get("finished_at"):
+            ends.setdefault(r.get("worker"), []).append(r["finished_at"])
+    rates = [(len(t) - 1) / (max(t) - min(t)) for t in ends.values()
+             if len(t) > 1 and max(t) > min(t)]
+    return 60.0 * sum(rates) if rates else None
 
 
 def _cpu_medians(records):
