@@ -22,9 +22,11 @@ world file's geometry at scan height). Default: the tutorial's (0, 8, 0).
 
 --bench: the same --bench-runs runs (random free starts in world02, the tutorial's
 obstacle_avoidance.py, --duration s each) with 1 and 2 workers, each with and without
-simulator reuse; prints runs/min, the speed-up, the per-run overhead with reuse (median
-share of a run's wall time, and its stages) and the memory of the workers and simulators
-over the runs (figures printed, not asserted).
+simulator reuse; prints runs/min (the whole batch's, and once the workers are up), the
+speed-up, the per-run overhead with reuse (median share of a run's wall time, and its
+stages), the median CPU a run of each process (simulator, controller, worker, master,
+roslaunch, the driver's scheduler) and the cores used while stepping, and the memory of
+the workers and simulators over the runs (figures printed, not asserted).
 
 --bench-memory: --bench-runs runs (default 200) of --duration s (default 5) on one worker
 with reuse; prints the resident memory of the worker, its simulator and its controller
