@@ -133,6 +133,67 @@ def report(figures):
     return "\n".join(lines)
 
 
+def whole_bench(session, listener, args, figures):
+    """The loop figures of a full run (everything but the engine's)."""
+    loops = figures["loop"]
+    loops["free-running"] = measure_loop(session, listener, "free-running", False,
+                                         args.clock_hz, args.seconds, args.check_seconds)
+    loops["lockstep"] = measure_loop(session, listener, "lockstep", True, args.clock_hz,
+                                     args.seconds, args.check_seconds)
+    loops["lockstep + listeners"] = measure_loop(
+        session, listener, "lockstep + listeners", True, args.clock_hz, args.seconds,
+        args.check_seconds, watchers=True)
+    loops[UNLIMITED] = measure_loop(
+        session, listener, UNLIMITED, True, args.clock_hz, args.seconds,
+        args.check_seconds, watchers=True, extra=("watch_rate:=0",))
+    if args.clock_hz != SIMULATOR_DEFAULT_CLOCK_HZ:
+        loops["lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ] = measure_loop(
+            session, listener, "lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ, True,
+            SIMULATOR_DEFAULT_CLOCK_HZ, args.seconds, args.check_seconds)
+    figures["launch"] = launch_to_first_scan(session, listener, args.clock_hz)
+    if args.soak > 0:
+        figures["soak"] = soak(session, listener, args.soak, args.clock_hz)
+
+
+def listener_rounds(session, listener, args):
+    """--listeners-only: the lockstep loop without and with listeners, in turn."""
+    extra = () if args.watch_rate is None else ("watch_rate:=%g" % args.watch_rate,)
+    rounds = []
+    for index in range(args.listeners_only):
+        say("round %d of %d" % (index + 1, args.listeners_only))
+        without = measure_loop(session, listener, "lockstep", True, args.clock_hz,
+                               args.seconds, args.check_seconds, extra=extra)
+        watched = measure_loop(session, listener, "lockstep + listeners", True, args.clock_hz,
+                               args.seconds, args.check_seconds, watchers=True, extra=extra)
+        rounds.append({"without": without, "with": watched,
+                       "load": "%.2f" % os.getloadavg()[0]})
+    return rounds
+
+
+def rounds_report(figures):
+    lines = ["", "lockstep loop with listeners / without, round by round (load before %s):"
+             % figures["machine"]["load_before"]]
+    ratios = []
+    for index, pair in enumerate(figures["listener_rounds"]):
+        without, watched = pair["without"], pair["with"]
+        ratio = 100.0 * watched["x_real_time"] / without["x_real_time"] \
+            if without["x_real_time"] and watched["x_real_time"] else None
+        if ratio is not None:
+            ratios.append(ratio)
+        cpu0, cpu1 = without["cpu_ms_per_sim_s"], watched["cpu_ms_per_sim_s"]
+        lines.append("  round %d: %sx -> %sx = %s %%; CPU per sim s [ms] simulator %s -> %s, "
+                     "controller %s -> %s, listeners %s (%s); load %s" % (
+                         index + 1, fmt(without["x_real_time"]), fmt(watched["x_real_time"]),
+                         fmt(ratio, "%.0f"), fmt(cpu0["simulator"], "%.1f"),
+                         fmt(cpu1["simulator"], "%.1f"), fmt(cpu0["controller"], "%.1f"),
+                         fmt(cpu1["controller"], "%.1f"), fmt(cpu1["listeners"], "%.1f"),
+                         ", ".join("%s %s" % (n, fmt(v, "%.1f"))
+                                   for n, v in cpu1["each_listener"].items()), pair["load"]))
+    if ratios:
+        lines.append("  median: %.0f %% (target >= 90 %%)" % sorted(ratios)[len(ratios) // 2])
+    return "\n".join(lines)
+
+
 def parse_args(argv):
     parser = argparse.ArgumentParser(prog="bench.sh", description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=15.0,
@@ -143,12 +204,21 @@ def parse_args(argv):
                         help="/clock rate the demo uses [Hz sim] (default 20)")
     parser.add_argument("--soak", type=float, default=0.0, metavar="MINUTES",
                         help="also run a soak of MINUTES of wall time (default: none)")
+    parser.add_argument("--listeners-only", type=int, default=0, metavar="ROUNDS",
+                        help="only the lockstep loop without and with listeners, ROUNDS times "
+                             "in turn (the listener target's ratio per round and its median); "
+                             "no engine, free-running or launch figures")
+    parser.add_argument("--watch-rate", type=float, default=None, metavar="HZ",
+                        help="with --listeners-only: the simulator's ~watch_rate (default: its "
+                             "own, 30)")
     parser.add_argument("--output", default=os.path.join(ROOT, "output"),
                         help="folder for bench.json and logs (default output/)")
     args = parser.parse_args(argv)
     for name in ("seconds", "check_seconds", "clock_hz"):
         if not (math.isfinite(getattr(args, name)) and getattr(args, name) > 0):
             parser.error("--%s must be a number > 0" % name.replace("_", "-"))
+    if args.listeners_only < 0:
+        parser.error("--listeners-only must be a number of rounds >= 1")
     if not (math.isfinite(args.soak) and args.soak >= 0):
         parser.error("--soak must be a number of minutes >= 0")
     return args
@@ -169,34 +239,22 @@ def main(argv=None):
                "world": WORLD, "start": dict(zip(("x", "y", "yaw"), START)), "loop": {}}
     status = 0
     try:
-        say("engine alone (no ROS)")
-        figures["engine"] = engine_figures()
-        say("  stepSimulation %.1fx, World.step %.1fx real time, scan %.3f ms" % (
-            figures["engine"]["physics_only"]["x_real_time"],
-            figures["engine"]["engine_step"]["x_real_time"], figures["engine"]["scan"]["ms_mean"]))
+        if not args.listeners_only:
+            say("engine alone (no ROS)")
+            figures["engine"] = engine_figures()
+            say("  stepSimulation %.1fx, World.step %.1fx real time, scan %.3f ms" % (
+                figures["engine"]["physics_only"]["x_real_time"],
+                figures["engine"]["engine_step"]["x_real_time"],
+                figures["engine"]["scan"]["ms_mean"]))
         session.start_master()
         os.environ.update(ROS_MASTER_URI=session.master_uri, ROS_HOSTNAME="localhost")
         import rospy
         rospy.init_node("m2wr_bench", disable_signals=True)
         listener = Listener()
-        loops = figures["loop"]
-        loops["free-running"] = measure_loop(session, listener, "free-running", False,
-                                             args.clock_hz, args.seconds, args.check_seconds)
-        loops["lockstep"] = measure_loop(session, listener, "lockstep", True, args.clock_hz,
-                                         args.seconds, args.check_seconds)
-        loops["lockstep + listeners"] = measure_loop(
-            session, listener, "lockstep + listeners", True, args.clock_hz, args.seconds,
-            args.check_seconds, watchers=True)
-        loops[UNLIMITED] = measure_loop(
-            session, listener, UNLIMITED, True, args.clock_hz, args.seconds,
-            args.check_seconds, watchers=True, extra=("watch_rate:=0",))
-        if args.clock_hz != SIMULATOR_DEFAULT_CLOCK_HZ:
-            loops["lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ] = measure_loop(
-                session, listener, "lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ, True,
-                SIMULATOR_DEFAULT_CLOCK_HZ, args.seconds, args.check_seconds)
-        figures["launch"] = launch_to_first_scan(session, listener, args.clock_hz)
-        if args.soak > 0:
-            figures["soak"] = soak(session, listener, args.soak, args.clock_hz)
+        if args.listeners_only:
+            figures["listener_rounds"] = listener_rounds(session, listener, args)
+        else:
+            whole_bench(session, listener, args, figures)
     except SessionError as err:
         sys.stderr.write("bench: %s\n" % err)
         status = 1
@@ -213,6 +271,8 @@ def main(argv=None):
     path = os.path.join(out, "bench.json")
     with open(path, "w") as dump:
         json.dump(figures, dump, indent=2, default=str)
+    if figures.get("listener_rounds"):
+        print(rounds_report(figures), flush=True)
     if "engine" in figures:
         print(report(figures) if figures["loop"] else "", flush=True)
     say("figures written to %s" % path)

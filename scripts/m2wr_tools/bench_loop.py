@@ -142,8 +142,8 @@ def start_watchers(session):
 
 
 def watchers_cpu(pids):
-    """CPU seconds the listener processes have used together (0 without listeners)."""
-    return sum(processes.cpu_seconds(pid) or 0.0 for pid in pids)
+    """CPU seconds each listener process has used so far, by name."""
+    return {name: processes.cpu_seconds(pid) or 0.0 for name, pid in pids.items()}
 
 
 def stop_loop(session):
@@ -163,7 +163,7 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         call_empty(UNPAUSE_SERVICE)
         time.sleep(warmup)
         session.check_running(["world", "controller"])
-        watcher_pids = [session.children[n].pid for n in WATCHERS] if watchers else []
+        watcher_pids = {n: session.children[n].pid for n in WATCHERS} if watchers else {}
         sim0, wall0, touches0 = listener.wait_sim(), time.monotonic(), listener.touches
         cpu0 = (processes.cpu_seconds(sim_pid), processes.cpu_seconds(ctrl_pid),
                 watchers_cpu(watcher_pids))
@@ -173,6 +173,8 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
                 watchers_cpu(watcher_pids))
         session.check_running(["world", "controller"])
         sim_s, wall_s = sim1 - sim0, wall1 - wall0
+        per_sim_s = (lambda seconds: 1e3 * seconds / sim_s if sim_s > 0 else None)
+        each_listener = {n: per_sim_s(cpu1[2][n] - cpu0[2][n]) for n in watcher_pids}
         # the scan/answer count: a window that starts and ends paused, with the counters
         # connected beforehand (/rosout is latched: its last line arrives on connecting)
         listener.count()
@@ -200,8 +202,9 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         "cpu_ms_per_sim_s": {
             "simulator": 1e3 * (cpu1[0] - cpu0[0]) / sim_s if sim_s > 0 else None,
             "controller": 1e3 * (cpu1[1] - cpu0[1]) / sim_s if sim_s > 0 else None,
-            "listeners": 1e3 * (cpu1[2] - cpu0[2]) / sim_s if sim_s > 0 and watchers
-            else None},
+            "listeners": per_sim_s(sum(cpu1[2].values()) - sum(cpu0[2].values()))
+            if watchers else None,
+            "each_listener": each_listener},
         "check": {"scans_published": scans + missing, "scans_heard": scans,
                   "handled_by_controller": handled, "cmd_vel_answers": answers,
                   "missing_scans": missing,
@@ -212,6 +215,11 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
     }
     say("  %.1fx real time (%.1f s sim in %.1f s wall); controller got every scan: %s" % (
         result["x_real_time"], sim_s, wall_s, result["check"]["verdict"]))
+    say("  CPU per sim s [ms]: simulator %s, controller %s%s; load %.2f" % (
+        fmt(result["cpu_ms_per_sim_s"]["simulator"], "%.1f"),
+        fmt(result["cpu_ms_per_sim_s"]["controller"], "%.1f"),
+        "".join(", %s %s" % (n, fmt(v, "%.1f")) for n, v in each_listener.items()),
+        os.getloadavg()[0]))
     return result
 
 

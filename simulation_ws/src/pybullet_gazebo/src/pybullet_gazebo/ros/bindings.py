@@ -76,6 +76,11 @@ class Binding:
         """Whether a controller publishes on one of this part's command topics."""
         return any(s.get_num_connections() for s in self.subscribers)
 
+    def commanders(self) -> set:
+        """The nodes that publish on this part's command topics (its controllers)."""
+        return {c.callerid_pub for s in self.subscribers if s.impl is not None
+                for c in list(s.impl.connections)}
+
     def close(self):
         for subscriber in self.subscribers:
             subscriber.unregister()
@@ -186,6 +191,9 @@ class RobotBindings:
 
     def commands_heard(self) -> bool:
         return any(b.commands_heard() for b in self.by_part.values())
+
+    def commanders(self) -> set:
+        return set().union(*(b.commanders() for b in self.by_part.values()))
 
     def close(self):
         for binding in self.by_part.values():

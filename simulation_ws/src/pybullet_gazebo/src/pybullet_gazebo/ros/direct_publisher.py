@@ -15,11 +15,16 @@ asked (select, no wait) whether it can take more; a subscriber whose buffer is f
 this message, as a full queue of queue_size=1 would drop it, and the others get it. The
 kernel's buffers on localhost hold hundreds of scans, so a subscriber that keeps up never
 misses one.
+
+`publish(msg, share)`: `share(connection)` picks the subscribers that get this message
+(clock_topic.py sends every /clock tick to controllers, fewer to displays). Whatever the
+subset, the message is serialized once and the same bytes written to each socket.
 """
 import select
 import warnings
 
 import rospy
+from rospy.msg import serialize_message
 
 
 class DirectPublisher:
@@ -32,7 +37,10 @@ class DirectPublisher:
     def get_num_connections(self):
         return self.publisher.get_num_connections()
 
-    def publish(self, msg):
+    def publish(self, msg, share=None):
+        """Writes `msg` to every subscriber that can take it now, or, with `share`, to those
+        of them for which share(connection) is true (rospy's TCPROS connection; its
+        endpoint_id is the subscriber's node name)."""
         impl = self.publisher.impl
         if impl is None:
             return
@@ -40,20 +48,51 @@ class DirectPublisher:
         if not connections:
             impl.publish(msg)             # keeps rospy's latch and sequence number
             return
+        everyone = len(connections)
+        if share is not None:
+            connections = [c for c in connections if share(c)]
         sockets = [getattr(c, "socket", None) for c in connections]
         try:
             _, writable, _ = select.select([], [s for s in sockets if s is not None], [], 0)
         except (OSError, ValueError):     # a socket closed meanwhile: rospy will drop it
             writable = []
-        if len(writable) == len(connections):
+        if len(writable) == everyone:
             self.publisher.publish(msg)
             return
         ready = set(writable)
-        for connection, sock in zip(connections, sockets):
-            if sock in ready:
-                impl.publish(msg, connection_override=connection)
-            else:
-                self.skipped += 1
+        chosen = [c for c, sock in zip(connections, sockets) if sock in ready]
+        self.skipped += len(connections) - len(chosen)
+        self._write(impl, msg, chosen)
+
+    @staticmethod
+    def _write(impl, msg, connections):
+        """What rospy's publish does for all its connections, for some of them: serialize
+        once (next sequence number, latch kept), write, close the connections that failed."""
+        failed = []
+        impl.acquire()
+        try:
+            if impl.closed:
+                return
+            if impl.is_latch:
+                impl.latch = msg
+            if not connections:
+                return
+            buff = impl.buff
+            impl.seq += 1
+            serialize_message(buff, impl.seq, msg)
+            data = buff.getvalue()
+            buff.seek(0)
+            buff.truncate(0)
+            impl.message_data_sent += len(data)
+            for connection in connections:
+                try:
+                    connection.write_data(data)
+                except Exception:         # as rospy's publish: that connection is dropped
+                    failed.append(connection)
+        finally:
+            impl.release()
+        for connection in failed:
+            connection.close()            # rospy drops it from the topic's connections
 
     def unregister(self):
         self.publisher.unregister()

@@ -3,7 +3,9 @@
 Node name `gazebo`, so its services and topics are Gazebo's: the whole API of
 gazebo_ros_api_plugin (gazebo_services.py and the modules it lists), and
 Topics out:
-  /clock (rosgraph_msgs/Clock) when /use_sim_time, at ~pub_clock_frequency [Hz sim]
+  /clock (rosgraph_msgs/Clock) when /use_sim_time, at ~pub_clock_frequency [Hz sim]; to
+            nodes that only watch, faster than real time at most max(~watch_rate, that
+            rate) per wall second (clock_topic.py)
   ~model_states (gazebo_msgs/ModelStates), ~link_states (gazebo_msgs/LinkStates) at
             ~model_states_rate [Hz sim], built only while someone listens (state_topics.py);
             faster than real time at most max(~watch_rate, that rate) per wall second
@@ -16,7 +18,8 @@ Topics out:
   (nav_msgs/Odometry) and TF odometryFrame -> robotBaseFrame at its updateRate (/tf is
   advertised once a robot's drive needs it: an empty world has none, as Gazebo), and the
   joint states (joint_states, sensor_msgs/JointState). /clock, scans, odometry and /tf are
-  written in the loop's thread (direct_publisher.py) and never limited in wall time.
+  written in the loop's thread (direct_publisher.py); scans, odometry and /tf are never
+  limited in wall time, nor /clock to the nodes that command a robot.
 Topics in: per robot, the diff drive's commandTopic (geometry_msgs/Twist); Gazebo's
 ~set_model_state and ~set_link_state (state_services.py). Not /clock: the node is its
 source (see nodes/gazebo_world).
@@ -29,7 +32,6 @@ import time
 import pybullet
 import rospy
 from gazebo_msgs.msg import ContactState, ContactsState
-from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 from pybullet_utils.bullet_client import BulletClient
 
@@ -37,6 +39,7 @@ from pybullet_gazebo.engine.world import World
 from pybullet_gazebo.gui.window import open_window
 from pybullet_gazebo.ros import conversions
 from pybullet_gazebo.ros.bindings import BindingContext, RobotBindings
+from pybullet_gazebo.ros.clock_topic import ClockTopic
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
@@ -85,7 +88,8 @@ class SimulatorNode:
         self._last_clock_step = 0
         self._model_states_every = self._steps_per_period(params.model_states_rate)
 
-        self.clock_pub = DirectPublisher("/clock", Clock) if params.use_sim_time else None
+        self.clock_pub = ClockTopic(params.pub_clock_frequency, params.watch_rate,
+                                    self._commanders) if params.use_sim_time else None
         self.state_topics = StateTopics(self.world, topic_limit(params.watch_rate,
                                                                 params.model_states_rate))
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100,
@@ -187,6 +191,8 @@ class SimulatorNode:
     def _loop(self):
         while not rospy.is_shutdown():
             if self.paused:
+                if self.clock_pub is not None:
+                    self.clock_pub.flush()        # displays learn the paused time
                 time.sleep(0.01)
                 continue
             if not self.lockstep.wait_if_due(self.world.sim_time, self._commands_heard):
@@ -209,6 +215,10 @@ class SimulatorNode:
     def _commands_heard(self):
         return any(b.commands_heard() for b in list(self._bindings.values()))
 
+    def _commanders(self):
+        """Nodes that command a robot: they get every /clock tick (clock_topic.py)."""
+        return set().union(*(b.commanders() for b in list(self._bindings.values())))
+
     def _publish(self, readings):
         """Publishes what is due after a step, stamped with its sim time; returns the number
         of scans published."""
@@ -221,7 +231,7 @@ class SimulatorNode:
             return 0
         stamp = conversions.stamp_of_world(self.world)
         if clock_due:
-            self.clock_pub.publish(Clock(stamp))
+            self.clock_pub.publish(stamp)
         scans = 0
         for reading in readings:
             bindings = self._bindings.get(reading.robot.name)
@@ -239,7 +249,7 @@ class SimulatorNode:
         that loop on rospy.Rate, whose tick may have fallen since the last /clock."""
         with self.lock:
             if self.world.step_count != self._last_clock_step and self._clock_due(force=True):
-                self.clock_pub.publish(Clock(conversions.stamp_of_world(self.world)))
+                self.clock_pub.publish(conversions.stamp_of_world(self.world))
 
     def _clock_due(self, force):
         """/clock every _clock_every steps and on each step with readings (`force`), counted

@@ -1,0 +1,112 @@
+"""/clock (rosgraph_msgs/Clock): the simulator's sim time, for every node with /use_sim_time.
+
+Who gets which tick:
+  controllers   nodes that publish a robot's command topic to the simulator (the diff drive's
+                commandTopic: the lockstep partners) get every tick the simulator sends: at
+                ~pub_clock_frequency [Hz sim] and at each step that publishes readings, so
+                that a controller's rospy.Rate wakes in time.
+  watchers      every other subscriber (rviz, robot_state_publisher, rostopic, a monitor) gets
+                /clock as Gazebo sends it, at ~pub_clock_frequency in sim time, and, faster than
+                real time, at most max(~watch_rate, pub_clock_frequency) ticks per wall second
+                (watch_rate.py): as many per wall second as at real time, each further ahead.
+                When the simulation pauses, each watcher gets the latest tick it missed
+                (flush), so every node agrees on the paused time. ~watch_rate 0: every
+                subscriber gets every tick.
+
+Why: every message wakes its subscriber. On the 2-core machine, in lockstep at ~35x real time,
+/clock was 80 of the ~106 messages per sim second an rviz-like set of listeners woke up for
+(20 Hz of sim time to each of 4 processes); each wake-up costs the simulator's thread a
+context switch and the cores the listener's own work, while the simulator and the controller
+need both cores. A display draws 30 frames per wall second: 700 clock ticks per wall second
+show nothing more.
+"""
+import math
+import time
+
+from rosgraph_msgs.msg import Clock
+
+from pybullet_gazebo.ros.direct_publisher import DirectPublisher
+from pybullet_gazebo.ros.watch_rate import WallRateLimit, topic_limit
+
+
+class _Watcher:
+    """What /clock sent one watching subscriber: its wall-time limit and last tick."""
+
+    def __init__(self, wall_limit, clock):
+        self.limit = WallRateLimit(wall_limit, clock)
+        self.last = None                    # [s] sim time of the last tick it got
+
+
+class ClockTopic:
+    def __init__(self, clock_rate, watch_rate, controllers, clock=time.monotonic):
+        """`clock_rate` [Hz sim]: ~pub_clock_frequency; `watch_rate` [Hz wall]: ~watch_rate;
+        `controllers()`: the names of the nodes that command a robot, now."""
+        self.publisher = DirectPublisher("/clock", Clock)
+        self._period = 1.0 / clock_rate if clock_rate > 0 else 0.0      # [s] sim
+        self._wall_limit = topic_limit(watch_rate, clock_rate)         # [Hz] wall
+        self._limited = watch_rate > 0
+        self._controllers = controllers
+        self._clock = clock
+        self._watchers = {}                 # node name -> _Watcher
+        self._latest = None                 # the last tick sent (a Clock message)
+
+    def publish(self, stamp):
+        """One tick at sim time `stamp` (rospy Time) to whoever is due for it."""
+        msg = Clock(stamp)
+        self._latest = msg
+        if not self._limited:
+            self.publisher.publish(msg)
+            return
+        now = stamp.to_sec()
+        controllers = self._controllers()
+        self._forget_gone()
+
+        def share(connection):
+            node = connection.endpoint_id
+            if node in controllers:
+                return True
+            watcher = self._watcher(node)
+            since = math.inf if watcher.last is None else now - watcher.last
+            # at its sim-time rate (half a step of slack for float sums); a reset: at once
+            if (since >= 0.999 * self._period or since < 0) and watcher.limit.allow():
+                watcher.last = now
+                return True
+            return False
+
+        self.publisher.publish(msg, share)
+
+    def flush(self):
+        """The latest tick to each watcher that has not had it (call while paused)."""
+        if self._latest is None or not self._watchers:
+            return
+        now = self._latest.clock.to_sec()
+        behind = {node for node, w in self._watchers.items() if w.last != now}
+        if not behind:
+            return
+
+        def share(connection):
+            if connection.endpoint_id in behind:
+                self._watchers[connection.endpoint_id].last = now
+                return True
+            return False
+
+        self.publisher.publish(self._latest, share)
+
+    def _watcher(self, node):
+        watcher = self._watchers.get(node)
+        if watcher is None:
+            watcher = self._watchers[node] = _Watcher(self._wall_limit, self._clock)
+        return watcher
+
+    def _forget_gone(self):
+        """Drops the records of subscribers that left (anonymous nodes come and go)."""
+        if len(self._watchers) > 2 * self.publisher.get_num_connections() + 8:
+            impl = self.publisher.publisher.impl
+            present = {c.endpoint_id for c in impl.connections} if impl is not None else set()
+            self._watchers = {n: w for n, w in self._watchers.items() if n in present}
+
+    def get_num_connections(self):
+        return self.publisher.get_num_connections()
+
+    def unregister(self):
+        self.publisher.unregister()
