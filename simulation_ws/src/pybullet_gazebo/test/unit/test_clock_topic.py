@@ -1,8 +1,9 @@
-"""/clock as clock_topic.py shares it out: a controller (a node that commands a robot) gets
-every tick; a watching node (rviz, robot_state_publisher) gets Gazebo's cadence at real time
-and, faster than real time, at most max(watch_rate, pub_clock_frequency) ticks per wall
-second; when paused, everyone ends on the same time. The publisher is replaced by a recorder
-with fake connections and the wall clock by a counter, so no master is needed."""
+"""/clock as clock_topic.py shares it out: a loop node (one that commands a robot or reads its
+sensors or odometry) gets every tick; a watching node (robot_state_publisher, an rviz showing
+the robot and TF) gets Gazebo's cadence at real time and, faster than real time, at most
+max(watch_rate, pub_clock_frequency) ticks per wall second; when paused, everyone ends on the
+same time. The publisher is replaced by a recorder with fake connections and the wall clock by
+a counter, so no master is needed."""
 import rospy
 
 from pybullet_gazebo.ros import clock_topic

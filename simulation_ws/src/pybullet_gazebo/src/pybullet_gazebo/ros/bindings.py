@@ -56,6 +56,8 @@ class Binding:
         self.part = part
         self.context = context
         self.publishers: List = []                   # rospy or DirectPublisher: unregister()
+        # publishers whose subscribers take part in the loop (clock_topic.py): sensors, odometry
+        self.loop_publishers: List[DirectPublisher] = []
         self.subscribers: List[rospy.Subscriber] = []
         self.namespace = robot_namespace.plugin_namespace(robot.namespace, part.own_namespace)
 
@@ -76,10 +78,13 @@ class Binding:
         """Whether a controller publishes on one of this part's command topics."""
         return any(s.get_num_connections() for s in self.subscribers)
 
-    def commanders(self) -> set:
-        """The nodes that publish on this part's command topics (its controllers)."""
-        return {c.callerid_pub for s in self.subscribers if s.impl is not None
-                for c in list(s.impl.connections)}
+    def loop_nodes(self) -> set:
+        """The nodes that command this part or read its sensor or odometry topics: they may
+        act on what they get in sim time (a controller, bug2's supervisor), where a display
+        only shows it; see clock_topic.py."""
+        commanders = {c.callerid_pub for s in self.subscribers if s.impl is not None
+                      for c in list(s.impl.connections)}
+        return commanders.union(*(p.subscriber_nodes() for p in self.loop_publishers))
 
     def close(self):
         for subscriber in self.subscribers:
@@ -93,6 +98,7 @@ class LaserBinding(Binding):
         super().__init__(robot, part, context)
         self.scans = DirectPublisher(self.topic(part.topic), LaserScan)   # see its docstring
         self.publishers.append(self.scans)
+        self.loop_publishers.append(self.scans)
         self.frame_id = self.frame(part.frame_id, fall_back_to_namespace=False)
 
     def publish(self, data, stamp):
@@ -105,6 +111,7 @@ class DriveBinding(Binding):
         super().__init__(robot, part, context)
         self.odometry = DirectPublisher(self.topic(part.odometry_topic), Odometry)
         self.publishers.append(self.odometry)
+        self.loop_publishers.append(self.odometry)
         self.frames = (self.frame(part.odometry_frame, fall_back_to_namespace=True),
                        self.frame(part.robot_base_frame, fall_back_to_namespace=True))
         # /tf is advertised once a robot needs it (an empty world offers no /tf, as Gazebo)
@@ -192,8 +199,8 @@ class RobotBindings:
     def commands_heard(self) -> bool:
         return any(b.commands_heard() for b in self.by_part.values())
 
-    def commanders(self) -> set:
-        return set().union(*(b.commanders() for b in self.by_part.values()))
+    def loop_nodes(self) -> set:
+        return set().union(*(b.loop_nodes() for b in self.by_part.values()))
 
     def close(self):
         for binding in self.by_part.values():

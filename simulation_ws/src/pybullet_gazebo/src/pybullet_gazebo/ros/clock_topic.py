@@ -1,17 +1,21 @@
 """/clock (rosgraph_msgs/Clock): the simulator's sim time, for every node with /use_sim_time.
 
 Who gets which tick:
-  controllers   nodes that publish a robot's command topic to the simulator (the diff drive's
-                commandTopic: the lockstep partners) get every tick the simulator sends: at
+  loop nodes    nodes that publish a robot's command topic (the diff drive's commandTopic: the
+                lockstep partners) or read its sensor or odometry topics (the laser's scans,
+                the drive's odometryTopic: a controller, bug2's supervisor that switches
+                behaviours on its rospy.Rate) get every tick the simulator sends: at
                 ~pub_clock_frequency [Hz sim] and at each step that publishes readings, so
-                that a controller's rospy.Rate wakes in time.
-  watchers      every other subscriber (rviz, robot_state_publisher, rostopic, a monitor) gets
-                /clock as Gazebo sends it, at ~pub_clock_frequency in sim time, and, faster than
-                real time, at most max(~watch_rate, pub_clock_frequency) ticks per wall second
-                (watch_rate.py): as many per wall second as at real time, each further ahead.
-                When the simulation pauses, each watcher gets the latest tick it missed
-                (flush), so every node agrees on the paused time. ~watch_rate 0: every
-                subscriber gets every tick.
+                that their rospy.Rate wakes in time.
+  watchers      every other subscriber (robot_state_publisher, rviz showing only the robot and
+                TF, rostopic, a node reading model_states) gets /clock as Gazebo sends it, at
+                ~pub_clock_frequency in sim time, and, faster than real time, at most
+                max(~watch_rate, pub_clock_frequency) ticks per wall second (watch_rate.py): as
+                many per wall second as at real time, each further ahead. When the simulation
+                pauses, each watcher gets the latest tick it missed (flush), so every node
+                agrees on the paused time. ~watch_rate 0: every subscriber gets every tick.
+So a node that reads only /tf and the watching topics (model_states, link_states,
+joint_states: limited in wall time already) is a watcher; /tf itself is never limited.
 
 Why: every message wakes its subscriber. On the 2-core machine, in lockstep at ~35x real time,
 /clock was 80 of the ~106 messages per sim second an rviz-like set of listeners woke up for
@@ -38,14 +42,14 @@ class _Watcher:
 
 
 class ClockTopic:
-    def __init__(self, clock_rate, watch_rate, controllers, clock=time.monotonic):
+    def __init__(self, clock_rate, watch_rate, loop_nodes, clock=time.monotonic):
         """`clock_rate` [Hz sim]: ~pub_clock_frequency; `watch_rate` [Hz wall]: ~watch_rate;
-        `controllers()`: the names of the nodes that command a robot, now."""
+        `loop_nodes()`: the names of the loop nodes (see above), now."""
         self.publisher = DirectPublisher("/clock", Clock)
         self._period = 1.0 / clock_rate if clock_rate > 0 else 0.0      # [s] sim
         self._wall_limit = topic_limit(watch_rate, clock_rate)         # [Hz] wall
         self._limited = watch_rate > 0
-        self._controllers = controllers
+        self._loop_nodes = loop_nodes
         self._clock = clock
         self._watchers = {}                 # node name -> _Watcher
         self._latest = None                 # the last tick sent (a Clock message)
@@ -58,12 +62,12 @@ class ClockTopic:
             self.publisher.publish(msg)
             return
         now = stamp.to_sec()
-        controllers = self._controllers()
+        loop_nodes = self._loop_nodes()
         self._forget_gone()
 
         def share(connection):
             node = connection.endpoint_id
-            if node in controllers:
+            if node in loop_nodes:
                 return True
             watcher = self._watcher(node)
             since = math.inf if watcher.last is None else now - watcher.last

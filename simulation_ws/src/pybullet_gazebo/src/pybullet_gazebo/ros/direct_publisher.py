@@ -37,6 +37,11 @@ class DirectPublisher:
     def get_num_connections(self):
         return self.publisher.get_num_connections()
 
+    def subscriber_nodes(self):
+        """The names of the nodes subscribed now."""
+        impl = self.publisher.impl
+        return {c.endpoint_id for c in list(impl.connections)} if impl is not None else set()
+
     def publish(self, msg, share=None):
         """Writes `msg` to every subscriber that can take it now, or, with `share`, to those
         of them for which share(connection) is true (rospy's TCPROS connection; its

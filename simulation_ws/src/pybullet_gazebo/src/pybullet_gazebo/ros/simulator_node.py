@@ -89,7 +89,7 @@ class SimulatorNode:
         self._model_states_every = self._steps_per_period(params.model_states_rate)
 
         self.clock_pub = ClockTopic(params.pub_clock_frequency, params.watch_rate,
-                                    self._commanders) if params.use_sim_time else None
+                                    self._loop_nodes) if params.use_sim_time else None
         self.state_topics = StateTopics(self.world, topic_limit(params.watch_rate,
                                                                 params.model_states_rate))
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100,
@@ -215,9 +215,10 @@ class SimulatorNode:
     def _commands_heard(self):
         return any(b.commands_heard() for b in list(self._bindings.values()))
 
-    def _commanders(self):
-        """Nodes that command a robot: they get every /clock tick (clock_topic.py)."""
-        return set().union(*(b.commanders() for b in list(self._bindings.values())))
+    def _loop_nodes(self):
+        """Nodes that command a robot or read its sensors or odometry: they get every /clock
+        tick (clock_topic.py)."""
+        return set().union(*(b.loop_nodes() for b in list(self._bindings.values())))
 
     def _publish(self, readings):
         """Publishes what is due after a step, stamped with its sim time; returns the number
