@@ -2,6 +2,7 @@
 obstacle_avoidance.py), printed side by side and written to <output>/bench.json.
 
   scripts/bench.sh [--seconds 15] [--soak MINUTES] [--clock-hz 20] [--output output/]
+  scripts/bench.sh --listeners-only ROUNDS [--seconds 15] [--watch-rate HZ]
 
 Figures:
   whole loop        real-time factor of simulator + obstacle_avoidance.py, headless, with
@@ -26,7 +27,20 @@ Figures:
                     watch_rate (model_states and joint_states at most ~30-50 per wall second)
                     and with watch_rate:=0 (every message at its sim-time rate, as before the
                     limit); printed as ratios to the loop without, and the loop's ratio to
-                    World.step alone, all from the same run
+                    World.step alone, all from the same run. What the listeners stand for:
+                    robot_state_publisher is rviz's setup's own (C++); `rostopic hz /tf`
+                    stands for rviz's TF listener and `rostopic hz /joint_states` for a joint
+                    monitor (both Python: per message they cost more than rviz's C++); the
+                    /gazebo/model_states reader for a Gazebo tool or a learner's script. They
+                    are watchers (clock_topic.py): /clock at Gazebo's rate but at most
+                    max(watch_rate, /clock rate) per wall second. Not included: rviz's
+                    drawing. rviz itself (m2wr.rviz, Xvfb, Mesa's software GL) took 0.5-0.6
+                    of a core drawing at 30 fps whatever the simulator sends, on this 2-core
+                    machine more than all the stand-ins together (3-6 ms per sim s).
+  --listeners-only  just the lockstep loop without and with the listeners, ROUNDS times in
+                    turn: each round's ratio and the median, CPU per sim s of the simulator,
+                    the controller and each listener (the most robust figure on a shared
+                    machine: compare the listeners' CPU between builds)
 The machine is shared: the load average before and after is recorded with the figures.
 
 Where the simulator's time goes (profile recipe): run the loop (scripts/demo.sh, or
@@ -39,6 +53,12 @@ it, rospy's threads blocked in select/recv are not counted and the main thread's
 (lockstep, time.sleep(0) in a queued publisher's write_data) are missed. Figures of issue 16
 (before DirectPublisher): Bullet's step 28 %, ray casting 13 %, /clock 14 %, scan 10 %,
 waiting for the controller 23 %; about 20 % was rospy's queued publish's time.sleep(0).
+With DirectPublisher, time in TCPROSTransport.write_data (socket.sendall) is mostly a
+subscriber being woken: a loopback send wakes the reader, which on 2 busy cores often runs on
+the simulator's core while the simulator waits. With the listeners attached (before
+clock_topic.py) that line was 24 % of the main thread, half of it /clock to the 4 listeners.
+`-f raw` writes one line per stack: grep the main thread's (they start with "<module>
+(gazebo_world") and sum by function.
 """
 import argparse
 import json

@@ -126,7 +126,8 @@ def start_loop(session, lockstep, clock_hz, extra=()):
 # "rviz-like" listeners: a /gazebo/model_states subscriber, robot_state_publisher on
 # /joint_states (it publishes the wheels' TF), and subscribers of /tf and /joint_states.
 # `rostopic hz` takes messages raw (AnyMsg), so they cost the simulator's publishing, not
-# their own deserializing.
+# their own deserializing. None reads the scan or /odom: they are watchers, and get /clock
+# limited in wall time (clock_topic.py).
 WATCHERS = {
     "watch_model_states": ["rostopic", "hz", "/gazebo/model_states"],
     "robot_state_publisher": ["rosrun", "robot_state_publisher", "robot_state_publisher"],
