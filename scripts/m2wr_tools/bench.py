@@ -239,6 +239,11 @@ def parse_args(argv):
             parser.error("--%s must be a number > 0" % name.replace("_", "-"))
     if args.listeners_only < 0:
         parser.error("--listeners-only must be a number of rounds >= 1")
+    if args.watch_rate is not None and not (math.isfinite(args.watch_rate)
+                                            and args.watch_rate >= 0):
+        parser.error("--watch-rate must be a number of Hz >= 0 (0: no limit)")
+    if args.watch_rate is not None and not args.listeners_only:
+        parser.error("--watch-rate goes with --listeners-only (the full run measures both)")
     if not (math.isfinite(args.soak) and args.soak >= 0):
         parser.error("--soak must be a number of minutes >= 0")
     return args
