@@ -401,6 +401,81 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
                         out[i] = hit
 
 
+@njit(**_JIT)
+def _rotated(q, vx, vy, vz):
+    """(vx, vy, vz) rotated by the unit quaternion q (x, y, z, w): v + 2 w (u x v) +
+    2 u x (u x v), u the vector part (transforms.rotate's arithmetic)."""
+    ux, uy, uz, w = q[0], q[1], q[2], q[3]
+    tx = 2.0 * (uy * vz - uz * vy)
+    ty = 2.0 * (uz * vx - ux * vz)
+    tz = 2.0 * (ux * vy - uy * vx)
+    return (vx + w * tx + (uy * tz - uz * ty), vy + w * ty + (uz * tx - ux * tz),
+            vz + w * tz + (ux * ty - uy * tx))
+
+
+@njit(**_JIT)
+def fan_rays(link_position, link_orientation, offset_position, offset_orientation, cos_sin,
+             angle_min, increment, frame, fan, directions):
+    """A laser's rays in the world: the sensor frame is the link's pose (position (3,),
+    quaternion (4,) x, y, z, w) composed with the sensor's offset in the link (the same);
+    frame (4, 3) receives its origin and its x, y, z axes (unit columns of its rotation),
+    fan (8,) the kernels' fan (x axis, y axis, angle_min, increment), directions (n, 3)
+    the unit vectors cos(a_i) x + sin(a_i) y for cos_sin (n, 2) = (cos a_i, sin a_i).
+    Returns False (outputs unfinished) when a direction is not a finite non-zero vector."""
+    lq = link_orientation
+    ox, oy, oz = _rotated(lq, offset_position[0], offset_position[1], offset_position[2])
+    frame[0, 0] = link_position[0] + ox
+    frame[0, 1] = link_position[1] + oy
+    frame[0, 2] = link_position[2] + oz
+    ax, ay, az, aw = lq[0], lq[1], lq[2], lq[3]
+    bx, by, bz, bw = (offset_orientation[0], offset_orientation[1], offset_orientation[2],
+                      offset_orientation[3])
+    x = aw * bx + ax * bw + ay * bz - az * by             # the Hamilton product lq * offset
+    y = aw * by - ax * bz + ay * bw + az * bx
+    z = aw * bz + ax * by - ay * bx + az * bw
+    w = aw * bw - ax * bx - ay * by - az * bz
+    frame[1, 0] = 1.0 - 2.0 * (y * y + z * z)             # x axis: the matrix's columns
+    frame[1, 1] = 2.0 * (x * y + z * w)
+    frame[1, 2] = 2.0 * (x * z - y * w)
+    frame[2, 0] = 2.0 * (x * y - z * w)
+    frame[2, 1] = 1.0 - 2.0 * (x * x + z * z)
+    frame[2, 2] = 2.0 * (y * z + x * w)
+    frame[3, 0] = 2.0 * (x * z + y * w)
+    frame[3, 1] = 2.0 * (y * z - x * w)
+    frame[3, 2] = 1.0 - 2.0 * (x * x + y * y)
+    for axis in range(3):
+        fan[axis] = frame[1, axis]
+        fan[3 + axis] = frame[2, axis]
+    fan[6] = angle_min
+    fan[7] = increment
+    for i in range(cos_sin.shape[0]):
+        c, s = cos_sin[i, 0], cos_sin[i, 1]
+        dx = c * frame[1, 0] + s * frame[2, 0]
+        dy = c * frame[1, 1] + s * frame[2, 1]
+        dz = c * frame[1, 2] + s * frame[2, 2]
+        norm = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if not (norm > 0.0 and norm < math.inf):
+            return False
+        directions[i, 0] = dx / norm
+        directions[i, 1] = dy / norm
+        directions[i, 2] = dz / norm
+    return True
+
+
+@njit(**_JIT)
+def noisy_ranges(ranges, normals, mean, stddev, range_min, range_max, out):
+    """out (float32) = ranges with mean + stddev * normals[i] added to every finite one and
+    kept inside [range_min, range_max]; normals empty: no noise. (numpy's
+    Generator.normal(mean, stddev) is mean + stddev * standard_normal(), draw for draw.)"""
+    noisy = normals.shape[0] > 0
+    for i in range(ranges.shape[0]):
+        r = ranges[i]
+        if noisy and r < math.inf:
+            r = r + (mean + stddev * normals[i])
+            r = _fmin(_fmax(r, range_min), range_max)
+        out[i] = r
+
+
 def warm_up():
     """Compiles (or loads from numba's cache) the kernels with the argument types the
     caster passes; returns the seconds it took."""
@@ -425,4 +500,13 @@ def warm_up():
                           np.array([1], dtype=np.int64), triangle, np.array([7], dtype=np.int64),
                           -1, 0.0, 10.0, out, hint)
         assert out[0] == 2.0 and out[1] == np.inf, out
+    frame, fan, directions = np.empty((4, 3)), np.empty(8), np.empty((2, 3))
+    assert fan_rays(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3),
+                    np.array([0.0, 0.0, 0.0, 1.0]), np.array([[1.0, 0.0], [0.0, 1.0]]), 0.0,
+                    math.pi / 2, frame, fan, directions)
+    assert directions[1, 1] == 1.0 and frame[3, 2] == 1.0, (directions, frame)
+    out = np.empty(2, dtype=np.float32)
+    noisy_ranges(np.array([1.0, np.inf]), np.array([0.5, 0.5]), 0.0, 0.1, 0.1, 10.0, out)
+    assert out[0] == np.float32(1.05) and out[1] == np.inf, out
+    noisy_ranges(np.array([1.0, np.inf]), np.zeros(0), 0.0, 0.1, 0.1, 10.0, out)
     return time.perf_counter() - start

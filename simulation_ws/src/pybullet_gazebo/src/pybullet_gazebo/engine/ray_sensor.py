@@ -20,10 +20,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import ray_kernel
 from .part import Part, PartContext, next_period_time
 from .transforms import Pose
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
+_NO_NOISE = np.zeros(0)
 
 
 def _due(last, sim_time, period):
@@ -78,7 +80,13 @@ class RaySensor(Part):
         self.angle_increment = ((spec.max_angle - spec.min_angle) / (samples - 1)
                                 if samples > 1 else 0.0)              # [rad]
         angles = spec.min_angle + self.angle_increment * np.arange(samples)
-        self._beams = np.stack([np.cos(angles), np.sin(angles), np.zeros(samples)], axis=1)
+        self._cos_sin = np.ascontiguousarray(np.stack([np.cos(angles), np.sin(angles)], axis=1))
+        self._offset = (np.array(spec.pose.position, dtype=float),
+                        np.array(spec.pose.orientation, dtype=float))
+        self._frame = np.empty((4, 3))       # scratch of measure(): ray_kernel.fan_rays'
+        self._fan = np.empty(8)
+        self._directions = np.empty((samples, 3))
+        self._noisy = spec.noise_stddev > 0.0 or spec.noise_mean != 0.0
         if link_index == -1:
             # pybullet reports the base's centre of mass; the link frame is offset from it
             self._base_inertial = Pose(*client.getDynamicsInfo(body_id, -1)[3:5]).inverse()
@@ -130,43 +138,48 @@ class RaySensor(Part):
     def skip(self, sim_time):
         """A scan due at `sim_time` [s] that nobody reads: nothing is cast, but the schedule
         and the noise stream advance exactly as measure() would advance them."""
-        spec = self.spec
-        if spec.noise_stddev > 0.0 or spec.noise_mean != 0.0:
-            # normal(mean, stddev, n) takes one standard normal draw per beam, as this does
-            self.rng.standard_normal(len(self._beams))
+        if self._noisy:
+            # measure() takes one standard normal draw per beam, as this does
+            self.rng.standard_normal(len(self._cos_sin))
         self._last = sim_time
 
-    def sensor_pose(self):
-        """World pose of the sensor frame: the link frame composed with the sensor's pose."""
+    def _link_frame(self):
+        """(position, quaternion) of the sensor's link frame in the world."""
         client = self._client
         if self.link_index == -1:
             link = Pose(*client.getBasePositionAndOrientation(self.body_id)).compose(
                 self._base_inertial)
-        else:
-            state = client.getLinkState(self.body_id, self.link_index,
-                                        computeForwardKinematics=True)
-            link = Pose(state[4], state[5])
-        return link.compose(self.spec.pose)
+            return link.position, link.orientation
+        state = client.getLinkState(self.body_id, self.link_index,
+                                    computeForwardKinematics=True)
+        return state[4], state[5]
+
+    def sensor_pose(self):
+        """World pose of the sensor frame: the link frame composed with the sensor's pose."""
+        return Pose(*self._link_frame()).compose(self.spec.pose)
 
     def measure(self, sim_time):
         """Scan now; returns a LaserScanData stamped `sim_time` [s]."""
         spec = self.spec
-        pose = self.sensor_pose()
-        axes = pose.matrix
-        directions = self._beams @ axes.T
-        ranges = self._caster.cast(pose.position, directions, spec.range_min,
-                                   spec.range_max, exclude_body=self.body_id,
-                                   fan=(axes[:, 0], axes[:, 1], spec.min_angle,
-                                        self.angle_increment))
-        if spec.noise_stddev > 0.0 or spec.noise_mean != 0.0:
-            # one draw per beam whether it hit or not, so the stream does not depend on the scene
-            noise = self.rng.normal(spec.noise_mean, spec.noise_stddev, len(ranges))
-            noisy = np.minimum(np.maximum(ranges + noise, spec.range_min), spec.range_max)
-            np.copyto(ranges, noisy, where=np.isfinite(ranges))    # returns only
+        position, orientation = self._link_frame()
+        frame, fan, directions = self._frame, self._fan, self._directions
+        if not ray_kernel.fan_rays(np.asarray(position, dtype=float),
+                                   np.asarray(orientation, dtype=float), self._offset[0],
+                                   self._offset[1], self._cos_sin, float(spec.min_angle),
+                                   float(self.angle_increment), frame, fan, directions):
+            raise ValueError("ray sensor '%s': its link's pose is not finite" % spec.name)
+        ranges = self._caster.cast_fan(frame, directions, fan, spec.range_min,
+                                       spec.range_max, exclude_body=self.body_id)
+        # one draw per beam whether it hit or not, so the stream does not depend on the scene
+        normals = self.rng.standard_normal(len(ranges)) if self._noisy else _NO_NOISE
+        out = np.empty(len(ranges), dtype=np.float32)
+        ray_kernel.noisy_ranges(ranges, normals, float(spec.noise_mean),
+                                float(spec.noise_stddev), float(spec.range_min),
+                                float(spec.range_max), out)
         self._last = sim_time
         return LaserScanData(
             stamp=sim_time, frame_id=self.frame_id,
             angle_min=float(spec.min_angle), angle_max=float(spec.max_angle),
             angle_increment=float(self.angle_increment), time_increment=0.0,
             scan_time=self._period, range_min=float(spec.range_min),
-            range_max=float(spec.range_max), ranges=ranges.astype(np.float32))
+            range_max=float(spec.range_max), ranges=out)

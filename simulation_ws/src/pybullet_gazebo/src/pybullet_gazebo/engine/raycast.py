@@ -358,31 +358,50 @@ class RayCaster:
         if not range_min < range_max or len(directions) == 0:
             return result
 
+        normal = self._coplanar_normal(directions)
+        fan = ray_kernel.NO_FAN if fan is None or normal is None else _fan_array(fan, directions)
+        return self._nearest(origin, directions, normal, fan, range_min, range_max,
+                             exclude_body, result)
+
+    def cast_fan(self, frame, directions, fan, range_min, range_max, exclude_body=None,
+                 cull=True):
+        """A laser's fan, as ray_kernel.fan_rays lays it out: frame (4, 3) the sensor's
+        origin and x, y, z axes, directions (n, 3) unit vectors in its xy plane, fan (8,)
+        the kernels' fan. Distances as cast() gives them; `cull`: try each shape only on
+        the beams that can reach it (the same distances to the last bit as without)."""
+        result = np.full(len(directions), np.inf)
+        range_min = max(0.0, float(range_min))
+        range_max = float(range_max)
+        if not range_min < range_max or len(directions) == 0:
+            return result
+        return self._nearest(frame[0], directions, frame[3], fan if cull else ray_kernel.NO_FAN,
+                             range_min, range_max, exclude_body, result)
+
+    def _nearest(self, origin, directions, normal, fan, range_min, range_max, exclude_body,
+                 result):
+        """Lowers result to the nearest hits (cast's job once its rays are checked): normal,
+        the unit normal of a plane through origin holding every ray, or None; fan, the
+        kernels' fan or NO_FAN."""
         static_shapes, static_planes, static_meshes = self._static()
         dynamic_shapes, dynamic_planes, dynamic_meshes = self._dynamic(exclude_body)
-        for body_id, point, normal in static_planes + dynamic_planes:
+        for body_id, point, plane_normal in static_planes + dynamic_planes:
             if body_id != exclude_body:
-                np.minimum(result, self._plane_hits(origin, directions, point, normal,
+                np.minimum(result, self._plane_hits(origin, directions, point, plane_normal,
                                                     range_min, range_max), out=result)
         shapes = self._join(static_shapes, dynamic_shapes)
-        normal = None
-        if shapes is not None or static_meshes is not None or dynamic_meshes is not None:
-            normal = self._coplanar_normal(directions)
-        fan = ray_kernel.NO_FAN if fan is None or normal is None else _fan_array(fan, directions)
+        if normal is None:
+            normal, fan = _NO_PLANE, ray_kernel.NO_FAN
+        exclude = -1 if exclude_body is None else int(exclude_body)
         for meshes in (static_meshes, dynamic_meshes):
             if meshes is not None:
                 ray_kernel.nearest_mesh_hits(
-                    origin, directions, _NO_PLANE if normal is None else normal,
-                    meshes.position, meshes.rotation, meshes.bound, meshes.start, meshes.count,
-                    meshes.triangles, meshes.body,
-                    -1 if exclude_body is None else int(exclude_body), range_min, range_max,
-                    result, fan)
+                    origin, directions, normal, meshes.position, meshes.rotation, meshes.bound,
+                    meshes.start, meshes.count, meshes.triangles, meshes.body, exclude,
+                    range_min, range_max, result, fan)
         if shapes is not None:
-            ray_kernel.nearest_hits(origin, directions, _NO_PLANE if normal is None else normal,
-                                    shapes.kind, shapes.position, shapes.rotation, shapes.size,
-                                    shapes.bound, shapes.body,
-                                    -1 if exclude_body is None else int(exclude_body),
-                                    range_min, range_max, result, fan)
+            ray_kernel.nearest_hits(origin, directions, normal, shapes.kind, shapes.position,
+                                    shapes.rotation, shapes.size, shapes.bound, shapes.body,
+                                    exclude, range_min, range_max, result, fan)
         return result
 
     def _join(self, static_shapes, dynamic_shapes):
