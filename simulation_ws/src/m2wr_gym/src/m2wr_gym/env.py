@@ -29,9 +29,9 @@ GOAL_RANGE = 30.0          # [m] bound of the goal's coordinates in the observat
 
 
 def _nearest(ranges):
-    """[m] the nearest laser return (inf when none)."""
-    finite = ranges[np.isfinite(ranges)]
-    return float(finite.min()) if len(finite) else math.inf
+    """[m] the nearest laser return (inf when none: no return is +inf; NaN is no return)."""
+    nearest = float(np.fmin.reduce(ranges)) if len(ranges) else math.inf
+    return math.inf if math.isnan(nearest) else nearest
 
 
 class M2wrEnv(gymnasium.Env):

@@ -81,6 +81,13 @@ class InProcessSim:
         self._drive = drives[0]
         self._laser = lasers[0]
         self._laser_last = None
+        entity = self.world.entity(ROBOT)
+        # the model frame from Bullet's centre-of-mass pose, as World.model_pose computes it
+        # (a robot's model frame is its root link's: no further offset)
+        assert entity.link_offsets[0] == Pose(), entity.link_offsets[0]
+        self._base_pose = self.client.getBasePositionAndOrientation
+        self._body = entity.body_ids[0]
+        self._com_to_model = entity.inertial_offsets[0].inverse()
         readings = self.world.step()           # the laser's first scan is due at once
         return self._snapshot(readings, ())
 
@@ -107,9 +114,11 @@ class InProcessSim:
             if hasattr(reading.data, "ranges"):
                 self._laser_last = reading.data
         scan = self._laser_last
-        pose = self.world.model_pose(ROBOT)
+        position, orientation = self._base_pose(self._body)
+        pose = Pose(position, orientation).compose(self._com_to_model)
         yaw = yaw_from_quaternion(pose.orientation)
-        return Snapshot(np.array(scan.ranges, dtype=np.float32), float(scan.range_max),
+        # (the scan's own float32 array: each scan is a new one, and nothing writes to it)
+        return Snapshot(scan.ranges, float(scan.range_max),
                         float(pose.position[0]), float(pose.position[1]), float(yaw),
                         float(self.world.sim_time), touched)
 

@@ -14,9 +14,9 @@ What may not happen in between, and how each is ruled out:
   while no robot can come near anything but itself and the ground models (`safe_time`).
   A point of a robot moves at most at S_r = max over its links of |v| + |w| r (v, w: the
   link's velocity, r: the radius about its centre of mass that holds its collision shapes)
-  now, any other dynamic model's at S_o, and neither accelerates by more than
-  MAX_ACCELERATION; so their gap closes by at most 2 (S_r + S_o) t + MAX_ACCELERATION t^2
-  in t seconds (the 2 for good measure). The gap to each model near the robot is Bullet's
+  now, another dynamic model's at S_o (its own; a static model's is 0), and neither
+  accelerates by more than MAX_ACCELERATION; so their gap closes by at most
+  2 (S_r + S_o) t + MAX_ACCELERATION t^2 in t seconds (the 2 for good measure). The gap to each model near the robot is Bullet's
   own distance between their collision shapes (getClosestPoints; models farther away than
   what can close within the horizon are left out by one getOverlappingObjects); batches
   run until that closing plus CONTACT_SLACK could reach the smallest gap (Bullet makes a
@@ -152,38 +152,41 @@ class Batcher:
         self._step()
         self._set(fixedTimeStep=step_size, numSubSteps=1)
 
-    def safe_time(self, robots, others, grounds, horizon):
+    def safe_time(self, robots, others, grounds, horizon, statics=frozenset()):
         """[s] of sim time, up to `horizon`, during which no robot (GuardedRobot) can touch
         any body but its own and the bodies in `grounds` (see the module docstring);
-        `others` [(body, radius)]: the dynamic bodies that are not robots."""
+        `others` [(body, radius)]: the dynamic bodies that are not robots; `statics`: bodies
+        that never move (their gaps close at the robot's speed alone)."""
         velocity, sqrt = self._base_velocity, math.sqrt
-        other_speed = 0.0
+        speeds = {}                   # body -> the speed of its fastest point now [m/s]
         for body, radius in others:
             (vx, vy, vz), (wx, wy, wz) = velocity(body)
-            other_speed = max(other_speed, sqrt(vx * vx + vy * vy + vz * vz)
-                              + radius * sqrt(wx * wx + wy * wy + wz * wz))
+            speeds[body] = sqrt(vx * vx + vy * vy + vz * vz) + radius * sqrt(
+                wx * wx + wy * wy + wz * wz)
+        other_speed = max(speeds.values(), default=0.0)
         reached = []
         for robot in robots:
             if robot.damped:
                 return 0.0
             reached.append(self._reach(robot))
+            speeds[robot.body] = reached[-1][2]
         safe = horizon
         for robot, (centre, extent, speed) in zip(robots, reached):
-            if len(robots) > 1:
-                speed += max([other_speed] + [s for other, (_, _, s) in zip(robots, reached)
-                                              if other is not robot])
-            else:
-                speed += other_speed
-            far = closing(speed, horizon)
-            grow = extent + far
+            fastest = max([other_speed] + [s for other, (_, _, s) in zip(robots, reached)
+                                           if other is not robot])
+            grow = extent + closing(speed + fastest, horizon)   # no gap closes by more
             hits = self._overlapping([c - grow for c in centre], [c + grow for c in centre])
-            gap = far
             for body in {body for body, _ in hits or ()
                          if body != robot.body and body not in grounds}:
+                # a static body's gap closes at the robot's speed, a moving one's at both
+                # speeds (a body the World does not know: at the fastest known)
+                pair = speed + (0.0 if body in statics else speeds.get(body, fastest))
+                far = closing(pair, horizon)
+                gap = far
                 for point in self._closest(robot.body, body, far):
                     gap = min(gap, point[8])
-            if gap < far:
-                safe = min(safe, _time_to_close(speed, gap))
+                if gap < far:
+                    safe = min(safe, _time_to_close(pair, gap))
         return safe
 
     def _reach(self, robot):

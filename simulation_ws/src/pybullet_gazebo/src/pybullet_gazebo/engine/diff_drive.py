@@ -115,6 +115,7 @@ class DiffDrive(Part):
         self.anchor_links = list(anchor_links)
         self._anchored = None
         self._client = client
+        self._set_motor = client.setJointMotorControl2    # bound once: 40 calls a second
         self.body_id = body_id
         self._warn = warn
         self._warned = set()
@@ -271,8 +272,8 @@ class DiffDrive(Part):
                 self._hold(slot, index)
                 continue
             self._held[slot] = None
-            self._client.setJointMotorControl2(self.body_id, index, pybullet.VELOCITY_CONTROL,
-                                               targetVelocity=speed, force=self.wheel_torque)
+            self._set_motor(self.body_id, index, pybullet.VELOCITY_CONTROL,
+                            targetVelocity=speed, force=self.wheel_torque)
 
     def _anchor(self, standing):
         """Friction anchors on the wheels' ground contacts while the robot is told to stand
@@ -296,10 +297,9 @@ class DiffDrive(Part):
         held = self._held[slot]
         if held is None or abs(angle - held) > HOLD_SLACK:
             held = self._held[slot] = angle
-        self._client.setJointMotorControl2(self.body_id, index, pybullet.POSITION_CONTROL,
-                                           targetPosition=held, targetVelocity=0.0,
-                                           positionGain=HOLD_GAIN, velocityGain=1.0,
-                                           force=self.wheel_torque)
+        self._set_motor(self.body_id, index, pybullet.POSITION_CONTROL,
+                        targetPosition=held, targetVelocity=0.0, positionGain=HOLD_GAIN,
+                        velocityGain=1.0, force=self.wheel_torque)
 
     def _integrate_encoder(self, sim_time):
         """Noetic's encoder odometry: dead reckoning from the wheel joints' speeds."""

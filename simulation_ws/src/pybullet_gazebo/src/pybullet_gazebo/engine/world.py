@@ -68,6 +68,7 @@ class World:
         self._robots: Optional[List[Robot]] = None  # cache of robots()
         self._stepped = ([], [])                    # cache: (robot, part) pairs, (name, body)
         self._guarded = ([], [], frozenset())       # cache: GuardedRobots, others, ground bodies
+        self._statics = frozenset()                 # cache: bodies of static models
         self._settled = None        # layout_version after the last step (batches need one)
         self._single_until = -1     # step count before which advance steps one by one
         self._safe_until = -1       # step count up to which no contact can start
@@ -214,7 +215,8 @@ class World:
         k = self._batcher.largest_exact(self.step_size, k)
         if k > 1 and self.step_count + k > self._safe_until:
             robots, others, grounds = self._guarded
-            safe = self._batcher.safe_time(robots, others, grounds, most * self.step_size)
+            safe = self._batcher.safe_time(robots, others, grounds, most * self.step_size,
+                                           self._statics)
             self._safe_until = self.step_count + int(safe / self.step_size)
             wanted, k = k, self._batcher.largest_exact(
                 self.step_size, min(k, self._safe_until - self.step_count))
@@ -240,6 +242,8 @@ class World:
             self._stepped = ([(r, p) for r in self._robots for p in r.parts],
                              [(r.name, r.body_id) for r in self._robots])
             self._guarded = self._guard_lists()
+            self._statics = frozenset(body for e in self.entities.values()
+                                      if e.static and not e.is_ground for body in e.body_ids)
             self._settled = None
         return list(self._robots)
 
