@@ -144,6 +144,36 @@ def test_driving_into_a_barrier_gives_the_same_contact_events(make_world, world0
     assert calls.calls < calls.steps / 2          # batched while clear of the barrier
 
 
+def test_pressed_on_a_barrier_it_steps_one_by_one_and_reads_contacts_after_each(
+        make_world, world02, m2wr_urdf):
+    """Pushing on a barrier the guard refuses every batch: each step is one Bullet call and
+    the contacts are read after each (the events match single stepping: test above), but
+    the parts' hooks run only at their own times, not at every step."""
+    world = make_world(world02)
+    robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2))
+    drive(world, robot, [(0.5, 0.0)] * 30, batched=True)          # on the barrier by now
+    assert world.touching()
+    calls, counts = Calls(world), {"reads": 0, "hooks": 0}
+    update = world.contacts.update
+    drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
+    hook = drive_part.before_step
+
+    def read(*args):
+        counts["reads"] += 1
+        update(*args)
+
+    def counted_hook(*args):
+        counts["hooks"] += 1
+        hook(*args)
+    world.contacts.update, drive_part.before_step = read, counted_hook
+    touched = set()
+    world.advance(100, touched=touched)
+    assert touched and all(other.startswith("jersey_barrier") for _, other in touched)
+    assert calls.calls == calls.steps == 100
+    assert counts["reads"] == 100
+    assert counts["hooks"] < 30                   # the drive's 20 Hz, not every step
+
+
 def test_a_wrench_and_a_reset_in_between_stay_identical(make_world, world02, m2wr_urdf):
     """A body wrench on the chassis for 0.3 s (applied per step: no batch while it is
     scheduled), and reset_simulation half way."""
