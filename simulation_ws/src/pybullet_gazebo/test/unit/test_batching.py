@@ -144,6 +144,45 @@ def test_driving_into_a_barrier_gives_the_same_contact_events(make_world, world0
     assert calls.calls < calls.steps / 2          # batched while clear of the barrier
 
 
+def test_until_news_stops_at_each_reading_and_each_change_of_touches(make_world, world02,
+                                                                     m2wr_urdf):
+    """The ROS loop's way (advance(n, until_news=True), publishing after each call): every
+    call ends at the step that brought readings or changed the touches, never later, so
+    each is published at its own sim time; and the run is bit for bit single stepping's."""
+    commands = [(0.5, 0.0)] * 30 + [(-0.5, 0.0)] * 5         # into row A's face and back
+    pose = Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2)
+    single_world = make_world(world02)
+    single_robot = single_world.spawn_urdf("m2wr", m2wr_urdf, pose)
+    world = make_world(world02)
+    robot = world.spawn_urdf("m2wr", m2wr_urdf, pose)
+    calls = Calls(world)
+    parts = [next(p for p in r.parts if isinstance(p, DiffDrive)) for r in (single_robot, robot)]
+    news_steps, single_news = [], []
+    for command in commands:
+        for part in parts:
+            part.set_command(*command)
+        start = world.step_count
+        for _ in range(CONTROL):
+            touching = single_world.touching()
+            readings = single_world.step()
+            if readings or single_world.touching() != touching:
+                single_news.append((single_world.step_count, readings_record(readings),
+                                    single_world.touching()))
+        while world.step_count < start + CONTROL:
+            touching = world.touching()
+            readings = world.advance(start + CONTROL - world.step_count, until_news=True)
+            if readings or world.touching() != touching:
+                news_steps.append((world.step_count, readings_record(readings),
+                                   world.touching()))
+            else:
+                assert world.step_count == start + CONTROL     # no news: it ran them all
+        assert state(world, robot) == state(single_world, single_robot)
+    assert news_steps == single_news              # the same news at the same steps
+    assert any(touching for _, _, touching in news_steps)
+    assert list(world.contact_events) == list(single_world.contact_events)
+    assert calls.calls < calls.steps / 2          # still batched between the news
+
+
 def test_pressed_on_a_barrier_it_steps_one_by_one_and_reads_contacts_after_each(
         make_world, world02, m2wr_urdf):
     """Pushing on a barrier the guard refuses every batch: each step is one Bullet call and

@@ -21,6 +21,7 @@ class ContactTracker:
         self.events = deque(maxlen=max_events)   # the most recent touch onsets
         self.event_count = 0                     # every onset since the start
         self._touching = set()                   # (robot, other) pairs touching now
+        self.changes = 0                         # times the touching pairs changed
         self._client = self._contact_points = None
 
     def update(self, client, sim_time, robots: Iterable[Tuple[str, int]],
@@ -40,6 +41,8 @@ class ContactTracker:
             for pair in sorted(touching - self._touching):
                 self.events.append(ContactEvent(sim_time, *pair))
                 self.event_count += 1
+        if touching != self._touching:
+            self.changes += 1
         self._touching = touching
 
     def touching(self) -> List[Tuple[str, str]]:

@@ -138,18 +138,22 @@ class World:
         going on as if they had measured."""
         return self.advance(1, collect)
 
-    def advance(self, steps, collect=True, touched=None) -> List[Reading]:
+    def advance(self, steps, collect=True, touched=None, until_news=False) -> List[Reading]:
         """`steps` fixed steps, with the same readings (`collect` as for step), contact events,
         sim time and physics, to the last bit, as `steps` calls of step(); stretches in which
         nothing can happen between steps (no part's hook acts, no wrench, no contact can
         start: see batching.py) go to Bullet in one call. `touched`: a set that receives
-        every (robot, other model) pair touching after any of the steps."""
+        every (robot, other model) pair touching after any of the steps. `until_news`: stop
+        early, after the step that brought readings or changed which robots touch which
+        models (a caller that publishes those at once, as the ROS loop does; step_count says
+        how many steps ran)."""
         if self._robots is None:
             self.robots()                   # refreshes the caches after a spawn or delete
         parts, bodies = self._stepped
         readings = []
         left = steps
         self._safe_until = self._single_until = -1     # the guard's answers hold for one call
+        changes = self.contacts.changes if until_news else None
         while left > 0:
             now = self.sim_time
             for _, part in parts:
@@ -160,7 +164,11 @@ class World:
                 # a quiet stretch the contact guard would not batch: its steps one by one,
                 # contacts read after each, without the parts' hooks (idle until its end)
                 k = self._single_until - self.step_count
-                self._steps_one_by_one(k - 1, touched)
+                self._steps_one_by_one(k - 1, touched, changes)
+                if changes is not None and self.contacts.changes != changes:
+                    # a touch began or ended inside the stretch: news, stop at that step
+                    self._settled = self.layout_version
+                    return readings         # (empty: news ends every call at once)
                 self._batcher.step(self.step_size, 1)
                 self.step_count += 1
             else:
@@ -180,12 +188,16 @@ class World:
                 if touched is not None:
                     touched.update(self.contacts.touching())
             self._settled = self.layout_version
+            if changes is not None and (readings or self.contacts.changes != changes):
+                break
         return readings
 
-    def _steps_one_by_one(self, steps, touched):
+    def _steps_one_by_one(self, steps, touched, changes=None):
         """`steps` physics steps, one Bullet call each, the contacts read after each as
         advance reads them; for the inside of a quiet stretch (no part's hook acts, no
-        wrench), where stepping them one at a time skips nothing but idle hooks."""
+        wrench), where stepping them one at a time skips nothing but idle hooks. Stops after
+        a step when `changes` (not None) differs from the contacts' change count (which
+        robots touch which models changed)."""
         step, update, bodies = self._batcher.step, self.contacts.update, self._stepped[1]
         size = self.step_size
         for _ in range(steps):
@@ -195,6 +207,8 @@ class World:
                 update(self.client, self.sim_time, bodies, self._body_owner, self._grounds)
                 if touched is not None:
                     touched.update(self.contacts.touching())
+                if changes is not None and self.contacts.changes != changes:
+                    return
 
     def _quiet_steps(self, most, now):
         """How many of the next `most` steps, the first of which starts now (its before_step

@@ -105,6 +105,11 @@ class Lockstep:
         if self.enabled and needed_at is not None:
             self._awaited = (commands_before, needed_at)
 
+    def answer_needed_at(self):
+        """Sim time [s] before whose step lockstep may wait for an answer, or None."""
+        awaited = self._awaited
+        return awaited[1] if awaited is not None else None
+
     def forget(self):
         """A reset: no answer awaited, and no controller taken as silent any more."""
         self._awaited = None

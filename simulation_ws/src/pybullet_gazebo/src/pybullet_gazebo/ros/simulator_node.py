@@ -46,6 +46,8 @@ from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
 from pybullet_gazebo.ros.state_topics import StateTopics
 from pybullet_gazebo.ros.watch_rate import topic_limit
 
+MAX_STEPS_AHEAD = 50        # physics steps the loop takes at most in one World.advance
+
 
 class SimulatorNode:
     """Owns the World, the loop, /clock and the per-robot bindings; offers the Gazebo
@@ -200,7 +202,7 @@ class SimulatorNode:
             with self.lock:
                 if self.paused:                   # paused (or reset) while we waited
                     continue
-                readings = self.world.step()
+                readings = self.world.advance(self._steps_ahead(), until_news=True)
                 commands_before = self.lockstep.commands
                 now = self.world.sim_time
                 scans = self._publish(readings)
@@ -211,6 +213,28 @@ class SimulatorNode:
             # same), so physics runs on until then while the controller thinks.
             self.lockstep.expect_answer(commands_before, needed_at)
             self.pacer.pace(now)
+
+    def _steps_ahead(self):
+        """How many physics steps the loop may take in one World.advance (which stops early
+        at readings or a change of touches): up to the next /clock tick, model_states
+        message, or step before which lockstep may wait for an answer; one at a time when
+        paced to a real-time factor or drawing a window, so both stay smooth."""
+        if self.real_time_factor > 0 or self.window is not None:
+            return 1
+        world = self.world
+        ahead = MAX_STEPS_AHEAD
+        if self.clock_pub is not None:
+            ahead = min(ahead, self._clock_every - (world.step_count - self._last_clock_step))
+        if self.state_topics.heard():
+            ahead = min(ahead, self._model_states_every
+                        - world.step_count % self._model_states_every)
+        needed_at = self.lockstep.answer_needed_at()
+        if needed_at is not None:
+            steps = 1               # the steps after the first start before `needed_at`
+            while steps < ahead and world.time_after(steps) < needed_at:
+                steps += 1
+            ahead = min(ahead, steps)
+        return max(1, ahead)
 
     def _commands_heard(self):
         return any(b.commands_heard() for b in list(self._bindings.values()))
