@@ -568,31 +568,14 @@ def test_fan_hint_gives_the_same_ranges_to_the_last_bit(name):
     """The culled kernel against the full one (the caster's code before the hint) on many
     laser poses in the tutorial's worlds: level and tilted, 180 and 360 degree fans, and
     fans aimed so that a beam runs exactly through a box's corner or along its face."""
-    import os
-    from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
-    from pybullet_gazebo.engine.world import World
-    from pybullet_gazebo.engine.raycast import rotation_matrices
-    src = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
-    spec = load_world(os.path.join(src, "my_worlds", "worlds", name + ".world"),
-                      model_path_from_env(os.path.join(src, "pybullet_gazebo", "models")))
-    client = BulletClient(connection_mode=pybullet.DIRECT)
+    client, world = _tutorial_world(name)
     try:
-        world = World(client, spec, 0.005, warn=lambda message: None)
         caster = world.caster
         static_shapes = caster._static()[0]
         rng = np.random.default_rng(sum(map(ord, name)))
         hits = 0
         for trial in range(300):
-            origin = np.array([rng.uniform(-9, 9), rng.uniform(-9, 9), rng.uniform(0.05, 0.6)])
-            tilt = rng.normal(0.0, 0.05, 2) if trial % 3 == 0 else (0.0, 0.0)
-            yaw = rng.uniform(-math.pi, math.pi)
-            rotation = rotation_matrices(pybullet.getQuaternionFromEuler((*tilt, yaw)))[0]
-            if trial % 4 == 0:                    # lidar: all round, wrapping at +-pi
-                angle_min, samples = -math.pi, 720
-                increment = 2 * math.pi / samples
-            else:                                 # m2wr's laser
-                angle_min, samples = -math.pi / 2, 720
-                increment = math.pi / (samples - 1)
+            origin, _, rotation, angle_min, increment, samples = _laser_pose(rng, trial)
             if trial % 2 == 1:                    # a beam exactly through a box corner
                 j = rng.integers(len(static_shapes.kind))
                 corner = static_shapes.position[j] + static_shapes.rotation[j] @ (
@@ -606,6 +589,22 @@ def test_fan_hint_gives_the_same_ranges_to_the_last_bit(name):
         assert hits > 300 * 720 * 0.2             # the scans did meet the worlds' models
     finally:
         client.disconnect()
+
+
+def _laser_pose(rng, trial):
+    """A laser pose over one of the tutorial's worlds, drawn from `rng`: (origin (3,),
+    orientation quaternion (4,), rotation (3, 3), angle_min [rad], increment [rad],
+    samples); every third one tilted a little, every fourth an all-round lidar, the others
+    m2wr's 180 degree laser."""
+    origin = np.array([rng.uniform(-9, 9), rng.uniform(-9, 9), rng.uniform(0.05, 0.6)])
+    tilt = rng.normal(0.0, 0.05, 2) if trial % 3 == 0 else (0.0, 0.0)
+    orientation = np.array(pybullet.getQuaternionFromEuler(
+        (*tilt, rng.uniform(-math.pi, math.pi))))
+    rotation = rotation_matrices(orientation)[0]
+    samples = 720
+    if trial % 4 == 0:                            # lidar: all round, wrapping at +-pi
+        return origin, orientation, rotation, -math.pi, 2 * math.pi / samples, samples
+    return origin, orientation, rotation, -math.pi / 2, math.pi / (samples - 1), samples
 
 
 def _tutorial_world(name):
@@ -657,17 +656,8 @@ def test_laser_fan_matches_the_float64_reference(name):
         hits = grazing = 0
         trials = 300
         for trial in range(trials):
-            origin = np.array([rng.uniform(-9, 9), rng.uniform(-9, 9), rng.uniform(0.05, 0.6)])
-            tilt = rng.normal(0.0, 0.05, 2) if trial % 3 == 0 else (0.0, 0.0)
-            orientation = np.array(pybullet.getQuaternionFromEuler(
-                (*tilt, rng.uniform(-math.pi, math.pi))))
-            rotation = rotation_matrices(orientation)[0]
-            if trial % 4 == 0:                    # lidar: all round, wrapping at +-pi
-                angle_min, samples = -math.pi, 720
-                increment = 2 * math.pi / samples
-            else:                                 # m2wr's laser
-                angle_min, samples = -math.pi / 2, 720
-                increment = math.pi / (samples - 1)
+            origin, orientation, rotation, angle_min, increment, samples = \
+                _laser_pose(rng, trial)
             if trial % 2 == 1:
                 angle_min = _grazing_angle(rng, static_shapes, origin, rotation) \
                     - rng.integers(samples) * increment
