@@ -255,6 +255,24 @@ def _nearest_first(origin, kind, position, rotation, size, bound):
 
 
 @njit(**_JIT)
+def _origin_in_shape_frame(r, rx, ry, rz):
+    """The rays' origin in a shape's frame, r^T (origin - position), given (rx, ry, rz) =
+    position - origin and the shape's rotation r."""
+    return (-(r[0, 0] * rx + r[1, 0] * ry + r[2, 0] * rz),
+            -(r[0, 1] * rx + r[1, 1] * ry + r[2, 1] * rz),
+            -(r[0, 2] * rx + r[1, 2] * ry + r[2, 2] * rz))
+
+
+@njit(**_JIT)
+def _misses_bound(along, distance2, reach, reach2, range_min, range_max):
+    """True when a ray misses a shape's bounding sphere (radius reach, centre at squared
+    distance distance2 and at `along` down the ray; reach2 the padded radius squared) or
+    meets it out of [range_min, range_max]."""
+    return along < range_min - reach or along > range_max + reach \
+        or distance2 - along * along > reach2
+
+
+@njit(**_JIT)
 def _all_rays(n, windows):
     windows[0, 0] = 0
     windows[0, 1] = n - 1
@@ -293,10 +311,7 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
         if in_plane and abs(rx * plane_normal[0] + ry * plane_normal[1] + rz * plane_normal[2]) \
                 > _support(kind[j], r, size[j], plane_normal[0], plane_normal[1], plane_normal[2]):
             continue
-        # the origin in the shape's frame: r^T (origin - position)
-        ox = -(r[0, 0] * rx + r[1, 0] * ry + r[2, 0] * rz)
-        oy = -(r[0, 1] * rx + r[1, 1] * ry + r[2, 1] * rz)
-        oz = -(r[0, 2] * rx + r[1, 2] * ry + r[2, 2] * rz)
+        ox, oy, oz = _origin_in_shape_frame(r, rx, ry, rz)
         reach2 = (reach + 1e-9) * (reach + 1e-9)
         count = _fan_windows(fan, kind[j], r, size[j], rx, ry, rz, distance2, reach + 1e-9,
                              directions.shape[0], windows) \
@@ -310,9 +325,7 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
                     continue
                 dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
                 along = rx * dx + ry * dy + rz * dz
-                # rays that miss the bounding sphere, or meet it out of range, are skipped
-                if along < range_min - reach or along > range_max + reach \
-                        or distance2 - along * along > reach2:
+                if _misses_bound(along, distance2, reach, reach2, range_min, range_max):
                     continue
                 near, far = _interval(kind[j], size[j], ox, oy, oz,
                                       r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz,
@@ -375,9 +388,7 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
                             + rz * plane_normal[2]) > reach:
             continue
         r = rotation[j]
-        ox = -(r[0, 0] * rx + r[1, 0] * ry + r[2, 0] * rz)
-        oy = -(r[0, 1] * rx + r[1, 1] * ry + r[2, 1] * rz)
-        oz = -(r[0, 2] * rx + r[1, 2] * ry + r[2, 2] * rz)
+        ox, oy, oz = _origin_in_shape_frame(r, rx, ry, rz)
         reach2 = (reach + 1e-9) * (reach + 1e-9)
         windows_count = _fan_windows(fan, SPHERE, r, bound[j:j + 1], rx, ry, rz, distance2,
                                      reach + 1e-9, directions.shape[0], windows) \
@@ -389,8 +400,7 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
                     continue
                 dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
                 along = rx * dx + ry * dy + rz * dz
-                if along < range_min - reach or along > range_max + reach \
-                        or distance2 - along * along > reach2:
+                if _misses_bound(along, distance2, reach, reach2, range_min, range_max):
                     continue
                 lx = r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz
                 ly = r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz
