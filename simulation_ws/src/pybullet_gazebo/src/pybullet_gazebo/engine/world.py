@@ -75,7 +75,6 @@ class World:
         self._batcher = Batcher(client)
         self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
-        self._step_simulation = client.stepSimulation   # bound once: called 200 times a second
         self.gravity = tuple(spec.physics.gravity)   # [m/s^2]
         self.wrenches = WrenchSchedule(client, self.gravity)   # apply_body_wrench & co.
         self.layout_version = 0     # counts teleports and deletions (caches of static poses)
@@ -149,7 +148,7 @@ class World:
         how many steps ran)."""
         if self._robots is None:
             self.robots()                   # refreshes the caches after a spawn or delete
-        parts, bodies = self._stepped
+        parts = self._stepped[0]
         readings = []
         left = steps
         self._safe_until = self._single_until = -1     # the guard's answers hold for one call
@@ -183,10 +182,7 @@ class World:
                         readings.append(Reading(robot, part, part.measure(now)))
                     else:
                         part.skip(now)
-            if self.step_count > self._safe_until:    # (within it no robot touches a model)
-                self.contacts.update(self.client, now, bodies, self._body_owner, self._grounds)
-                if touched is not None:
-                    touched.update(self.contacts.touching())
+            self._read_contacts(touched)
             self._settled = self.layout_version
             if changes is not None and (readings or self.contacts.changes != changes):
                 break
@@ -198,17 +194,25 @@ class World:
         wrench), where stepping them one at a time skips nothing but idle hooks. Stops after
         a step when `changes` (not None) differs from the contacts' change count (which
         robots touch which models changed)."""
-        step, update, bodies = self._batcher.step, self.contacts.update, self._stepped[1]
-        size = self.step_size
+        step, size = self._batcher.step, self.step_size
         for _ in range(steps):
             step(size, 1)
             self.step_count += 1
-            if self.step_count > self._safe_until:
-                update(self.client, self.sim_time, bodies, self._body_owner, self._grounds)
-                if touched is not None:
-                    touched.update(self.contacts.touching())
-                if changes is not None and self.contacts.changes != changes:
-                    return
+            if self._read_contacts(touched) and changes is not None \
+                    and self.contacts.changes != changes:
+                return
+
+    def _read_contacts(self, touched):
+        """Reads who touches whom after a step, unless the contact guard proved no robot
+        touches a model up to this step; `touched` (a set, or None) receives the pairs.
+        True when read."""
+        if self.step_count <= self._safe_until:
+            return False
+        self.contacts.update(self.client, self.sim_time, self._stepped[1], self._body_owner,
+                             self._grounds)
+        if touched is not None:
+            touched.update(self.contacts.touching())
+        return True
 
     def _quiet_steps(self, most, now):
         """How many of the next `most` steps, the first of which starts now (its before_step
