@@ -2,9 +2,11 @@
 """rostest, Gazebo's force services as a Gazebo user sees them (empty world at 4x real time, m2wr and
 a 2 kg SDF crate): apply_body_wrench pushes for its duration of sim time (from its start_time;
 a negative duration until clear_body_wrenches), apply_joint_effort turns a wheel until
-clear_joint_forces; bad input answered success false, naming the input, nothing applied."""
+clear_joint_forces; bad input answered success false, naming the input, nothing applied;
+clearing an unknown link or joint clears nothing and the simulator's warning names it."""
 import os
 import sys
+import time
 import unittest
 
 import rospy
@@ -14,6 +16,7 @@ from geometry_msgs.msg import Point, Twist, Vector3, Wrench
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gazebo_api_client import Gazebo, pose, spawn_crate, spawn_m2wr   # noqa: E402
+from pybullet_gazebo.ros.testing import NodeLog   # noqa: E402
 
 WEIGHT = 2.0 * 9.8            # [N] the crate's
 LIFT = Wrench(Vector3(0.0, 0.0, 2.0 * WEIGHT), Vector3())      # net 9.8 m/s^2 up
@@ -24,6 +27,7 @@ class Wrenches(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_api_wrenches")
         cls.gazebo = Gazebo()
+        cls.simulator_log = NodeLog("/gazebo")
         spawn_m2wr(cls.gazebo)
         spawn_crate(cls.gazebo, x=3.0)
         cls.gazebo.wait_sim(0.3)
@@ -32,6 +36,15 @@ class Wrenches(unittest.TestCase):
         self.gazebo.pause_physics()
         self.gazebo.set_model_state(ModelState("crate", pose(3.0, 0.0, 0.15), Twist(), ""))
         self.now = rospy.Time.from_sec(self.gazebo.sim_time())
+
+    def assert_warned(self, *words, timeout=10.0):
+        """The simulator logged a line holding every one of `words` (on /rosout)."""
+        deadline = time.monotonic() + timeout
+        while not any(all(w in text for w in words) for _, text in self.simulator_log.since(0)):
+            if time.monotonic() > deadline:
+                raise AssertionError("the simulator logged no line with %s; it logged %s"
+                                     % (words, [t for _, t in self.simulator_log.since(0)][-5:]))
+            time.sleep(0.02)
 
     def crate_z(self):
         return self.gazebo.get_model_state("crate", "").pose.position.z
@@ -60,6 +73,9 @@ class Wrenches(unittest.TestCase):
     def test_a_negative_duration_pushes_until_cleared(self):
         self.gazebo.apply_body_wrench("crate::body", "", Point(), LIFT, rospy.Time(0),
                                       rospy.Duration(-1.0))
+        self.gazebo.clear_body_wrenches("crate::lid")         # no such link: clears nothing
+        self.assert_warned("clear_body_wrenches: link 'crate::lid' does not exist",
+                           "nothing cleared")
         self.gazebo.unpause_physics()
         self.gazebo.wait_sim(0.5)
         self.assertGreater(self.crate_z(), 1.0)       # 0.15 + 1.2 m after 0.5 s, rising
@@ -68,11 +84,13 @@ class Wrenches(unittest.TestCase):
         self.assertLess(self.crate_z(), 0.3)
 
     def test_a_joint_effort_spins_a_wheel_until_cleared(self):
-        self.gazebo.unpause_physics()
         answer = self.gazebo.apply_joint_effort("joint_left_wheel", 20.0, rospy.Time(0),
                                                 rospy.Duration(-1.0))
         self.assertTrue(answer.success, answer.status_message)
         self.assertEqual(answer.status_message, "ApplyJointEffort: effort set")
+        self.gazebo.clear_joint_forces("elbow")                # no such joint: clears nothing
+        self.assert_warned("clear_joint_forces: joint 'elbow' does not exist", "nothing cleared")
+        self.gazebo.unpause_physics()
         self.gazebo.wait_sim(0.3)
         spinning = self.gazebo.get_joint_properties("joint_left_wheel").rate[0]
         self.assertGreater(abs(spinning), 2.0)        # over the drive's 5 N m holding it
@@ -98,6 +116,16 @@ class Wrenches(unittest.TestCase):
              "joint 'elbow' does not exist"),
             (self.gazebo.apply_joint_effort, ("joint_left_wheel", nan, rospy.Time(0),
                                               rospy.Duration(1)), "effort"),
+            (self.gazebo.apply_body_wrench, ("crate::body", "", Point(),
+                                             Wrench(Vector3(), Vector3(0, 0, float("inf"))),
+                                             rospy.Time(0), rospy.Duration(1)), "wrench.torque"),
+            (self.gazebo.apply_body_wrench, ("crate::body", "", Point(),
+                                             Wrench(Vector3(0, 0, 1e12), Vector3()),
+                                             rospy.Time(0), rospy.Duration(1)), "over 1e+09"),
+            (self.gazebo.apply_joint_effort, ("", 1.0, rospy.Time(0), rospy.Duration(1)),
+             "joint '' does not exist"),
+            (self.gazebo.apply_joint_effort, ("joint_left_wheel", float("inf"), rospy.Time(0),
+                                              rospy.Duration(1)), "effort [inf]"),
         ]
         for call, args, message in cases:
             answer = call(*args)

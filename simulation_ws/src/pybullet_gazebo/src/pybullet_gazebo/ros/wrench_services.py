@@ -9,7 +9,9 @@ world), about reference_point in that frame; the stand-in applies the force at t
 centre of mass and the torque (including reference_point x force), both turned into the
 world frame. (Gazebo's own transformation of a wrench with a reference frame is a FIXME in
 its source; this is what its documentation says.) Bad input (unknown link, joint or frame,
-NaN or inf) answers success false naming it and schedules nothing.
+NaN or inf) answers success false naming it and schedules nothing. The clear services' answers
+have no fields (as Gazebo's): clearing an unknown link or joint clears nothing and logs a
+warning naming it.
 """
 import math
 
@@ -70,8 +72,9 @@ class WrenchServices:
         with self.sim.lock:
             try:
                 name = model_access.find_link(self.sim.world, req.body_name).scoped
-            except LookupError:
-                name = req.body_name
+            except LookupError as err:
+                rospy.logwarn("clear_body_wrenches: %s; nothing cleared", err)
+                return BodyRequestResponse()
             self.sim.world.wrenches.clear_body_wrenches(name)
         return BodyRequestResponse()
 
@@ -92,7 +95,8 @@ class WrenchServices:
         with self.sim.lock:
             try:
                 name = model_access.find_joint(self.sim.world, req.joint_name).scoped
-            except LookupError:
-                name = req.joint_name
+            except LookupError as err:
+                rospy.logwarn("clear_joint_forces: %s; nothing cleared", err)
+                return JointRequestResponse()
             self.sim.world.wrenches.clear_joint_efforts(name)
         return JointRequestResponse()
