@@ -3,7 +3,7 @@
 and an SDF crate spawned): get/set_model_state with reference frames, a zero quaternion and a
 twist; get/set_link_state; the /gazebo/set_model_state and /gazebo/set_link_state topics;
 /gazebo/model_states and /gazebo/link_states; and bad input answered success false, naming the
-input, with nothing changed."""
+input, with nothing changed (on the two topics: dropped, with a warning naming it)."""
 import math
 import os
 import sys
@@ -17,7 +17,7 @@ from geometry_msgs.msg import Twist, Vector3
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gazebo_api_client import Gazebo, pose, spawn_crate, spawn_m2wr   # noqa: E402
-from pybullet_gazebo.ros.testing import wait_for_message   # noqa: E402
+from pybullet_gazebo.ros.testing import NodeLog, wait_for_message   # noqa: E402
 
 
 def xyz(p):
@@ -37,6 +37,7 @@ class States(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_api_states")
         cls.gazebo = Gazebo()
+        cls.simulator_log = NodeLog("/gazebo")
         spawn_m2wr(cls.gazebo, x=0.0, y=0.0)
         spawn_crate(cls.gazebo, x=3.0, y=0.0)
         cls.gazebo.wait_sim(0.5)
@@ -150,11 +151,48 @@ class States(unittest.TestCase):
              "non-finite"),
             (self.gazebo.set_link_state, (LinkState("m2wr::link_left_wheel", pose(), Twist(), ""),),
              "root link only"),
+            (self.gazebo.set_link_state, (LinkState("crate::lid", pose(), Twist(), ""),),
+             "link 'crate::lid' does not exist"),
+            (self.gazebo.set_link_state, (LinkState("", pose(), Twist(), ""),),
+             "link '' does not exist"),
+            (self.gazebo.set_link_state, (LinkState("crate::body", pose(3, 0, 0.15), Twist(),
+                                                    "nowhere"),), "reference frame 'nowhere'"),
+            (self.gazebo.set_link_state, (LinkState("crate::body", pose(3, 0, 0.15),
+                                                    Twist(Vector3(), Vector3(0, 0, math.inf)),
+                                                    ""),), "non-finite"),
+            (self.gazebo.get_link_state, ("crate::body", "nowhere"), "reference frame 'nowhere'"),
         ]
         for call, args, message in cases:
             answer = call(*args)
             self.assertFalse(answer.success, (args, answer.status_message))
             self.assertIn(message, answer.status_message, args)
+        self.assertEqual(self.gazebo.snapshot(), before)
+        self.gazebo.unpause_physics()
+        self.gazebo.wait_sim(0.05)                       # the simulation goes on
+
+    def test_bad_messages_on_the_state_topics_are_dropped_with_a_warning(self):
+        models = rospy.Publisher("/gazebo/set_model_state", ModelState, queue_size=10)
+        links = rospy.Publisher("/gazebo/set_link_state", LinkState, queue_size=10)
+        wait_until(lambda: models.get_num_connections() > 0 and links.get_num_connections() > 0,
+                   "simulator subscribed")
+        self.gazebo.pause_physics()
+        self.addCleanup(self.gazebo.unpause_physics)
+        before = self.gazebo.snapshot()
+        nan = float("nan")
+        messages = [
+            (models, ModelState("ghost", pose(), Twist(), ""),
+             "/gazebo/set_model_state message ignored: model 'ghost' does not exist"),
+            (models, ModelState("crate", pose(nan, 0.0, 0.15), Twist(), ""),
+             "model state of 'crate' is not finite"),
+            (links, LinkState("crate::lid", pose(), Twist(), ""),
+             "/gazebo/set_link_state message ignored: link 'crate::lid' does not exist"),
+            (links, LinkState("crate::body", pose(0.0, 0.0, 0.15), Twist(), "nowhere"),
+             "reference frame 'nowhere'"),
+        ]
+        for publisher, message, warning in messages:     # each reason said, none throttled
+            publisher.publish(message)
+            wait_until(lambda: any(warning in text for _, text in self.simulator_log.since(0)),
+                       "the simulator's warning '%s'" % warning)
         self.assertEqual(self.gazebo.snapshot(), before)
         self.gazebo.unpause_physics()
         self.gazebo.wait_sim(0.05)                       # the simulation goes on

@@ -6,7 +6,8 @@ Poses [m] and twists [m/s, rad/s] are in the reference frame named by the reques
 a `model::link`; "", "world", "map" = the world), as Gazebo computes them. set_model_state
 normalizes the quaternion (all zeros = the identity, as Gazebo) and sets the twist. A request
 that cannot be honoured answers success false naming the input and changes nothing; a topic
-message that cannot is logged (throttled) and dropped.
+message that cannot is dropped with a warning naming it (each distinct reason at once, the
+same reason again at most every 5 s).
 """
 import rospy
 from gazebo_msgs.msg import LinkState, ModelState
@@ -88,7 +89,7 @@ class StateServices:
         try:
             self._set_model_state(msg)
         except (LookupError, ValueError) as err:
-            rospy.logwarn_throttle(5.0, "/gazebo/set_model_state message ignored: %s" % err)
+            rospy.logwarn_throttle_identical(5.0, "/gazebo/set_model_state message ignored: %s" % err)
 
     # --- links ----------------------------------------------------------------------------------
     def get_link_state(self, req):
@@ -133,4 +134,4 @@ class StateServices:
         try:
             self._set_link_state(msg)
         except (LookupError, ValueError) as err:
-            rospy.logwarn_throttle(5.0, "/gazebo/set_link_state message ignored: %s" % err)
+            rospy.logwarn_throttle_identical(5.0, "/gazebo/set_link_state message ignored: %s" % err)
