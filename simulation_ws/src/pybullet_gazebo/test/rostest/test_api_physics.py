@@ -2,7 +2,8 @@
 """rostest, Gazebo's physics properties as a Gazebo user sees them (empty world, real time, an
 SDF crate): get/set_physics_properties with time_step, max_update_rate (0 = as fast as
 possible) and gravity; ODE settings refused (Bullet physics); the physics dynamic_reconfigure
-server; bad input answered success false, naming the input, nothing changed."""
+server; bad input answered success false, naming the input, nothing changed (through
+dynamic_reconfigure, which has no status: the values kept and a warning naming them)."""
 import os
 import sys
 import time
@@ -16,6 +17,7 @@ from geometry_msgs.msg import Twist, Vector3
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gazebo_api_client import Gazebo, pose, spawn_crate   # noqa: E402
+from pybullet_gazebo.ros.testing import NodeLog   # noqa: E402
 
 EARTH = Vector3(0.0, 0.0, -9.8)
 
@@ -25,6 +27,7 @@ class Physics(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_api_physics")
         cls.gazebo = Gazebo()
+        cls.simulator_log = NodeLog("/gazebo")
         spawn_crate(cls.gazebo, x=3.0)
         cls.initial = cls.gazebo.get_physics_properties()
 
@@ -93,7 +96,11 @@ class Physics(unittest.TestCase):
         cases = [((0.0, 200.0, EARTH), "time_step 0.0"), ((-0.001, 200.0, EARTH), "time_step"),
                  ((nan, 200.0, EARTH), "time_step nan"), ((0.005, -5.0, EARTH), "max_update_rate"),
                  ((0.005, nan, EARTH), "max_update_rate"),
-                 ((0.005, 200.0, Vector3(0, nan, 0)), "gravity")]
+                 ((0.005, 200.0, Vector3(0, nan, 0)), "gravity"),
+                 ((float("inf"), 200.0, EARTH), "time_step inf"),
+                 ((2.0, 200.0, EARTH), "time_step 2.0 must be in (0, 1] s"),
+                 ((0.005, float("inf"), EARTH), "max_update_rate inf"),
+                 ((0.005, 200.0, Vector3(0, 0, -float("inf"))), "gravity")]
         for args, message in cases:
             answer = self.gazebo.set_physics_properties(*args, self.initial.ode_config)
             self.assertFalse(answer.success, args)
@@ -102,6 +109,29 @@ class Physics(unittest.TestCase):
             self.assertEqual((now.time_step, now.max_update_rate, now.gravity.z),
                              (0.005, 200.0, -9.8))
         self.gazebo.wait_sim(0.05)
+
+    def test_dynamic_reconfigure_bad_values_change_nothing_and_are_named(self):
+        client = Client("/gazebo", timeout=10)
+        self.addCleanup(client.close)
+        nan, inf = float("nan"), float("inf")
+        cases = [({"time_step": 0.0}, "time_step 0.0 must be in (0, 1] s"),
+                 ({"time_step": 5.0}, "time_step 5.0 must be in (0, 1] s"),
+                 ({"time_step": nan}, "time_step nan must be finite"),
+                 ({"max_update_rate": nan}, "max_update_rate nan must be finite"),
+                 ({"gravity_z": inf}, "gravity_z inf must be finite")]   # not clamped to +100
+        for change, warning in cases:
+            config = client.update_configuration(change)
+            self.assertEqual((config["time_step"], config["max_update_rate"],
+                              config["gravity_z"]), (0.005, 200.0, -9.8), change)
+            now = self.gazebo.get_physics_properties()
+            self.assertEqual((now.time_step, now.max_update_rate, now.gravity.z),
+                             (0.005, 200.0, -9.8), change)
+            deadline = time.monotonic() + 10.0
+            while not any(warning in text for _, text in self.simulator_log.since(0)):
+                if time.monotonic() > deadline:
+                    self.fail("%s: the simulator logged no warning '%s'" % (change, warning))
+                time.sleep(0.02)
+        self.gazebo.wait_sim(0.05)                       # the simulation goes on
 
 
 if __name__ == "__main__":

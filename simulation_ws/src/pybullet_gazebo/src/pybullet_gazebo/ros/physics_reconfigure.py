@@ -7,8 +7,12 @@ Parameters: ~time_step [s], ~max_update_rate [Hz], ~gravity_x/y/z [m/s^2] plus O
 solver settings. As in Gazebo, the server starts from what get_physics_properties reports and
 hands changes to set_physics_properties' logic (`physics.set`). time_step, max_update_rate and
 gravity take effect; ODE's settings have no meaning for Bullet: a change to one is reported
-and the value stays what get_physics_properties reports.
+and the value stays what get_physics_properties reports. A request the physics refuses
+(time_step 0, say) changes nothing and is reported naming the value; a NaN or inf in a
+request is dropped, with a warning naming the parameter, before dynamic_reconfigure's clamp to
+the range would turn it into a bound (gravity_z inf would become +100 m/s^2).
 """
+import math
 import types
 
 import rospy
@@ -68,6 +72,22 @@ def physics_config_type():
         all_level=1)
 
 
+class FiniteValuesServer(Server):
+    """dynamic_reconfigure's Server, but a NaN or inf value in a request is dropped (its
+    parameter keeps its value) with a warning naming it, instead of being clamped to a bound
+    of the parameter's range (or, for NaN, passed on)."""
+
+    def update_configuration(self, changes):
+        non_finite = sorted(name for name, value in changes.items()
+                            if isinstance(value, float) and not math.isfinite(value))
+        if non_finite:
+            rospy.logwarn("physics reconfigure: %s must be finite; kept as they were"
+                          % ", ".join("%s %s" % (name, changes[name]) for name in non_finite))
+            changes = {name: value for name, value in changes.items()
+                       if name not in non_finite}
+        return super().update_configuration(changes)
+
+
 class PhysicsReconfigure:
     """`physics` gives properties() -> PhysicsProperties-like dict and set(time_step,
     max_update_rate, gravity) raising ValueError (see physics_services)."""
@@ -75,7 +95,7 @@ class PhysicsReconfigure:
     def __init__(self, physics):
         self.physics = physics
         self._started = False
-        self.server = Server(physics_config_type(), self._on_config)
+        self.server = FiniteValuesServer(physics_config_type(), self._on_config)
 
     def _current(self):
         now = self.physics.properties()
