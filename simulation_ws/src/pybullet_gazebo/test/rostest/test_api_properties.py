@@ -130,6 +130,20 @@ class Properties(unittest.TestCase):
              "1 joint names but 0 positions"),
             (self.gazebo.set_model_configuration, ("ghost", "", [], []),
              "model 'ghost' does not exist"),
+            (self.gazebo.set_model_configuration, ("", "", [], []), "model '' does not exist"),
+            (self.gazebo.set_model_configuration, ("m2wr", "", ["joint_left_wheel"],
+                                                   [float("inf")]), "inf"),
+            (self.gazebo.get_link_properties, ("",), "link '' does not exist"),
+            (self.gazebo.get_joint_properties, ("",), "joint '' does not exist"),
+            (self.gazebo.set_joint_properties, ("", ODEJointProperties()),
+             "joint '' does not exist"),
+            (self.gazebo.set_joint_properties, ("joint_left_wheel",
+                                                ODEJointProperties(damping=[-1.0])),
+             "damping [-1.0] must be >= 0"),
+            (self.gazebo.set_link_properties, ("crate::lid", props.com, True, 1, 1, 0, 0, 1, 0, 1),
+             "link 'crate::lid' does not exist"),
+            (self.gazebo.set_link_properties, ("crate::body", props.com, True, 1,
+                                               float("inf"), 0, 0, 1, 0, 1), "inf"),
         ]
         for call, args, message in cases:
             answer = call(*args)

@@ -102,6 +102,10 @@ class SpawnDelete(unittest.TestCase):
              "reference_frame not found"),
             (self.gazebo.spawn_sdf_model, ("", CRATE_SDF, "", pose(5, 5, 1), ""),
              "model name is empty"),
+            (self.gazebo.spawn_sdf_model, ("bad", "", "", pose(5, 5, 1), ""),
+             "model_xml is empty"),
+            (self.gazebo.spawn_sdf_model, ("bad", CRATE_SDF, "", pose(5, 5, 1, (nan, 0, 0, 1)),
+                                           ""), "not finite"),
             (self.gazebo.delete_model, ("ghost",), "model 'ghost' does not exist"),
             (self.gazebo.delete_model, ("",), "model '' does not exist"),
         ]
