@@ -3,7 +3,9 @@
 gazebo_ros's flags, as a Gazebo user would call it, in the shim's default empty world.
 
 Each case runs the client as a process and checks its exit code (0: the model is in the world;
-1: it is not, with the reason on stderr) and what /gazebo/get_world_properties then lists."""
+1: it is not, with the reason on stderr) and what /gazebo/get_world_properties then lists
+(and, for -J, -robot_namespace, -reference_frame and -R, the joint, topics and pose)."""
+import math
 import os
 import signal
 import subprocess
@@ -11,15 +13,21 @@ import tempfile
 import time
 import unittest
 
+import rosgraph
 import rospy
 import rostest
-from gazebo_msgs.srv import GetWorldProperties, SpawnModel
+from gazebo_msgs.srv import (GetJointProperties, GetModelState, GetWorldProperties,
+                             SpawnModel)
 from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty
 
-from pybullet_gazebo.ros.testing import model_pose, service, wait_until_sim_time
+from pybullet_gazebo.ros.testing import model_pose, service, wait_until_sim_time, yaw_of
 
 CLIENT = ["rosrun", "gazebo_ros", "spawn_model"]
+CRATE = """<sdf version="1.6"><model name="crate"><link name="body">
+  <inertial><mass>2.0</mass><inertia><ixx>0.05</ixx><iyy>0.05</iyy><izz>0.05</izz></inertia></inertial>
+  <collision name="shell"><geometry><box><size>0.3 0.3 0.3</size></box></geometry></collision>
+</link></model></sdf>"""
 
 
 def models():
@@ -145,6 +153,39 @@ class SpawnFlagsTest(unittest.TestCase):
         self.assertEqual(code, 1)
         self.assertIn("-J joint_left_wheel 'half' is not a number", err)
         self.assertNotIn("jointed", models())
+
+    def test_j_robot_namespace_reference_frame_and_roll_as_gazebo_s(self):
+        """-J sets the joint after the spawn; -robot_namespace puts the plugin topics under it;
+        -x .. -R .. -Y are taken in -reference_frame (here a crate turned 90 deg)."""
+        service("/gazebo/pause_physics", Empty)()         # the poses read as they were set
+        self.addCleanup(service("/gazebo/unpause_physics", Empty))
+        anchor = Pose()
+        anchor.position.x, anchor.position.y, anchor.position.z = -4.0, -4.0, 0.15
+        anchor.orientation.z = anchor.orientation.w = math.sqrt(0.5)          # yaw +90 deg
+        answer = service("/gazebo/spawn_sdf_model", SpawnModel)("anchor", CRATE, "", anchor, "")
+        self.assertTrue(answer.success, answer.status_message)
+        code, err = spawn("-urdf", "-param", "/robot_description", "-model", "posed",
+                          "-robot_namespace", "/third", "-reference_frame", "anchor",
+                          "-x", "1", "-z", "0.1", "-R", "0.2", "-J", "joint_left_wheel", "0.5")
+        self.assertEqual(code, 0, err)
+        state = service("/gazebo/get_model_state", GetModelState)("posed", "")
+        p, q = state.pose.position, state.pose.orientation
+        self.assertAlmostEqual(p.x, -4.0, delta=1e-3)         # 1 m along the crate's x = +y
+        self.assertAlmostEqual(p.y, -3.0, delta=1e-3)
+        self.assertAlmostEqual(p.z, 0.25, delta=1e-3)
+        roll = math.atan2(2 * (q.w * q.x + q.y * q.z), 1 - 2 * (q.x ** 2 + q.y ** 2))
+        self.assertAlmostEqual(roll, 0.2, delta=1e-3)
+        self.assertAlmostEqual(yaw_of(q), math.pi / 2, delta=1e-3)
+        joint = service("/gazebo/get_joint_properties", GetJointProperties)(
+            "posed::joint_left_wheel")
+        self.assertAlmostEqual(joint.position[0], 0.5, delta=1e-6)
+        subscribed = dict(rosgraph.Master("/test_spawn_flags").getSystemState()[1])
+        self.assertIn("/gazebo", subscribed.get("/third/cmd_vel", []))
+        code, err = spawn("-urdf", "-param", "/robot_description", "-model", "unjointed",
+                          "-y", "-9", "-J", "elbow", "1")     # Gazebo: spawned, then exit 1
+        self.assertEqual(code, 1)
+        self.assertIn("elbow", err)
+        self.assertIn("unjointed", models())
 
     def test_refused_spawn_exits_1_with_the_reason(self):
         code, err = spawn("-urdf", "-param", "/robot_description", "-model", "elsewhere",
