@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 import rospy
@@ -16,6 +17,7 @@ import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gazebo_api_client import CRATE_SDF, Gazebo, m2wr_urdf, pose   # noqa: E402
+from pybullet_gazebo.ros.testing import NodeLog   # noqa: E402
 
 
 class SpawnDelete(unittest.TestCase):
@@ -23,6 +25,7 @@ class SpawnDelete(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_api_spawn")
         cls.gazebo = Gazebo()
+        cls.simulator_log = NodeLog("/gazebo")
         answer = cls.gazebo.spawn_urdf_model("m2wr", m2wr_urdf(), "", pose(0, 0, 0.1), "")
         assert answer.success, answer.status_message
         cls.first = answer
@@ -71,6 +74,12 @@ class SpawnDelete(unittest.TestCase):
         self.assertTrue(answer.success, answer.status_message)
         self.assertIn("crate_in", self.names())
         self.assertIn("m2wr", self.names())
+        warning = "puts 'crate_in' inside 'm2wr'; spawned anyway, as Gazebo does"
+        deadline = time.monotonic() + 10.0
+        while not any(warning in text for _, text in self.simulator_log.since(0)):
+            if time.monotonic() > deadline:
+                self.fail("the simulator logged no warning '%s'" % warning)
+            time.sleep(0.02)
         self.gazebo.wait_sim(0.3)                 # physics pushes them apart; both stay sane
         self.assertTrue(self.gazebo.get_model_state("m2wr", "").success)
         self.gazebo.delete_model("crate_in")
