@@ -13,6 +13,7 @@ def engine_figures(steps=2000, scans=300):
     """Physics and scan costs of world02 + m2wr in a DIRECT client, no ROS."""
     import pybullet
     from pybullet_utils.bullet_client import BulletClient
+    from pybullet_gazebo.engine.diff_drive import DiffDrive
     from pybullet_gazebo.engine.ray_sensor import RaySensor
     from pybullet_gazebo.engine.sdf_world import load_world
     from pybullet_gazebo.engine.transforms import Pose
@@ -29,9 +30,8 @@ def engine_figures(steps=2000, scans=300):
                                                                  0, 0, START[2]))
         for _ in range(200):            # lands on its wheels
             world.step()
-        for component in robot.parts:
-            if hasattr(component, "set_command"):
-                component.set_command(0.0, 0.3)      # turning on the spot: wheels in contact
+        for drive in robot.parts_with(DiffDrive.KEY):
+            drive.set_command(0.0, 0.3)      # turning on the spot: wheels in contact
         t = time.perf_counter()
         for _ in range(steps):
             client.stepSimulation()
@@ -40,7 +40,7 @@ def engine_figures(steps=2000, scans=300):
         for _ in range(steps):
             world.step()
         engine = time.perf_counter() - t
-        sensor = next(c for c in robot.parts if isinstance(c, RaySensor))
+        sensor = robot.parts_with(RaySensor.KEY)[0]
         t = time.perf_counter()
         for _ in range(scans):
             sensor.measure(world.sim_time)

@@ -14,6 +14,8 @@ import numpy as np
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
+from pybullet_gazebo.engine.diff_drive import DiffDrive
+from pybullet_gazebo.engine.ray_sensor import RaySensor
 from pybullet_gazebo.engine.transforms import Pose, yaw_from_quaternion
 from pybullet_gazebo.engine.world import SpawnError, World
 
@@ -73,8 +75,8 @@ class InProcessSim:
         except SpawnError as err:
             raise ValueError("start pose (x=%.3f, y=%.3f, yaw=%.3f): %s" % (x, y, yaw, err)) \
                 from None
-        drives = [c for c in robot.parts if hasattr(c, "set_command")]
-        lasers = [c for c in robot.parts if getattr(c, "KEY", None) == "ray"]
+        drives = robot.parts_with(DiffDrive.KEY)
+        lasers = robot.parts_with(RaySensor.KEY)
         if len(drives) != 1 or len(lasers) != 1:
             raise RuntimeError("m2wr should have one drive and one laser; it has %d and %d"
                                % (len(drives), len(lasers)))

@@ -9,6 +9,8 @@ import pytest
 import xacro
 from pybullet_utils.bullet_client import BulletClient
 
+from pybullet_gazebo.engine.diff_drive import DiffDrive
+from pybullet_gazebo.engine.ray_sensor import RaySensor
 from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
 from pybullet_gazebo.engine.transforms import Pose
 from pybullet_gazebo.engine.world import World
@@ -34,8 +36,8 @@ def make_world(urdf):
                   warn=lambda message: None)
     world.spawn_sdf("box", BOX, Pose.from_xyz_rpy(2.0, 0.0, 0.5))
     robot = world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(0, 0, 0.1))
-    drive = next(p for p in robot.parts if hasattr(p, "set_command"))
-    laser = next(p for p in robot.parts if getattr(p, "KEY", "") == "ray")
+    [drive] = robot.parts_with(DiffDrive.KEY)
+    [laser] = robot.parts_with(RaySensor.KEY)
     drive.set_command(0.4, 0.3)
     return client, world, laser
 

@@ -11,6 +11,7 @@ import xacro
 from pybullet_utils.bullet_client import BulletClient
 
 from pybullet_gazebo.engine import model_access
+from pybullet_gazebo.engine.diff_drive import DiffDrive
 from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
 from pybullet_gazebo.engine.transforms import Pose
 from pybullet_gazebo.engine.world import World
@@ -52,9 +53,8 @@ def world(monkeypatch):
     urdf = xacro.process_file(os.path.join(SRC, "m2wr_description", "urdf",
                                            "m2wr.xacro")).toxml()
     robot = world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(0, 8, 0.1))
-    for part in robot.parts:
-        if hasattr(part, "set_command"):
-            part.set_command(0.3, 0.4)
+    for drive in robot.parts_with(DiffDrive.KEY):
+        drive.set_command(0.3, 0.4)
     yield world
     client.disconnect()
 

@@ -18,6 +18,11 @@ class Robot:
     initial_pose: Pose
     parts: List[Part] = field(default_factory=list)
 
+    def parts_with(self, key: str) -> List[Part]:
+        """The robot's parts that stand in for `key` (a Part KEY: a `<plugin filename>` or
+        a `<sensor type>`, e.g. DiffDrive.KEY, RaySensor.KEY), in the order they were built."""
+        return [part for part in self.parts if part.KEY == key]
+
 
 @dataclass
 class Entity:

@@ -86,9 +86,9 @@ def make_robot(client, body, spec: RobotSpec, pose, namespace, contacts, caster,
                  % (spec.name, plugin.name, plugin.filename))
             continue
         robot.parts.append(_build(part_class, context, plugin))
-    if not any(isinstance(p, JointStatePublisher) for p in robot.parts):
+    if not robot.parts_with(JointStatePublisher.KEY):
         # the drive's wheel joint states, for rviz (see joint_states.py)
-        for drive in [p for p in robot.parts if isinstance(p, DiffDrive)]:
+        for drive in robot.parts_with(DiffDrive.KEY):
             robot.parts.append(JointStatePublisher.for_wheels(context, drive))
     for sensor in spec.sensors:
         if sensor.link not in links:

@@ -86,9 +86,9 @@ class GuiWindow:
     # --- what the simulator tells it --------------------------------------------------
     def add_robot(self, robot, urdf_xml):
         flags = urdf_sensors_visualized(urdf_xml)
-        sensors = [c for c in robot.parts if isinstance(c, RaySensor)
-                   and (self.rays == "true"
-                        or (self.rays == "sdf" and flags.get(c.spec.name, False)))]
+        sensors = [c for c in robot.parts_with(RaySensor.KEY)
+                   if self.rays == "true"
+                   or (self.rays == "sdf" and flags.get(c.spec.name, False))]
         self._robots[robot.name] = (robot, sensors)
         self._send(("robot", robot.name, urdf_xml))
 
@@ -104,7 +104,7 @@ class GuiWindow:
         if not self._open:
             return
         for reading in readings:
-            if isinstance(reading.part, RaySensor):
+            if reading.part.KEY == RaySensor.KEY:
                 self._scans[id(reading.part)] = reading.data
         now = time.monotonic()
         if now < self._next_frame:
