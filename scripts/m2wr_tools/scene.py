@@ -23,6 +23,7 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from pybullet_gazebo.engine import wheel_contact
+from pybullet_gazebo.engine.planar import convex_hull
 from pybullet_gazebo.engine.sdf_world import load_world
 from pybullet_gazebo.engine.transforms import Pose, rotation_matrix
 from pybullet_gazebo.engine.world import World
@@ -51,28 +52,6 @@ class Clearance:
     distance: float          # [m] smallest robot-obstacle distance; < 0 = penetration
     model: str               # the obstacle it was to ("" when none within max_distance)
     index: int               # which pose
-
-
-def convex_hull(points) -> List[Tuple[float, float]]:
-    """Counter-clockwise convex hull of 2-D points (Andrew's monotone chain), without
-    repeated or collinear points."""
-    pts = sorted(set((float(x), float(y)) for x, y in points))
-    if len(pts) <= 2:
-        return pts
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower, upper = [], []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 1e-12:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 1e-12:
-            upper.pop()
-        upper.append(p)
-    return lower[:-1] + upper[:-1]
 
 
 def cut_convex(vertices, z) -> List[Tuple[float, float]]:

@@ -9,7 +9,7 @@ import pytest
 import xacro
 
 from m2wr_tools import scene as scene_mod
-from m2wr_tools.scene import Scene, convex_hull, cut_convex, cut_cylinder
+from m2wr_tools.scene import Scene, cut_convex, cut_cylinder
 from pybullet_gazebo.engine.transforms import Pose, rotation_matrix, quaternion_from_rpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -102,11 +102,6 @@ def test_moved_models_follow_and_unknown_names_are_returned(scene):
         assert by_model(scene.outlines(0.15))["post"].center == pytest.approx((1.0, -1.0))
     finally:
         scene.set_model_poses({"post": Pose.from_xyz_rpy(0.0, 3.0, 0.5)})
-
-
-def test_convex_hull_drops_inner_and_collinear_points():
-    points = [(0, 0), (2, 0), (1, 0), (2, 2), (0, 2), (1, 1)]
-    assert convex_hull(points) == [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]
 
 
 def test_rolled_box_cut_is_wider_than_its_thickness():

@@ -16,32 +16,13 @@ import math
 import numpy as np
 
 from pybullet_gazebo.engine.specs import Box, Cylinder, Plane, Sphere
+from pybullet_gazebo.engine.planar import convex_hull
 from pybullet_gazebo.engine.transforms import rotation_matrix
 
 ROBOT_TOP = 0.35                  # [m] top of m2wr's laser, with margin
 FOOTPRINT_X = (-0.25, 0.25)       # [m] chassis, in the robot frame (x forward)
 FOOTPRINT_Y = (-0.17, 0.17)       # [m] wheels' outer faces (y left)
 ROBOT_RADIUS = math.hypot(0.25, 0.17)   # [m] circle around the footprint
-
-
-def _hull(points):
-    """Counter-clockwise convex hull of 2-D points (monotone chain)."""
-    pts = sorted(set((round(float(x), 9), round(float(y), 9)) for x, y in points))
-    if len(pts) <= 2:
-        return pts
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    lower, upper = [], []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return lower[:-1] + upper[:-1]
 
 
 class Footprints:
@@ -105,7 +86,7 @@ class Footprints:
             return None
         if vertices[:, 2].max() < 0.0 or vertices[:, 2].min() > ROBOT_TOP:
             return None
-        return "polygon", _hull(vertices[:, :2])
+        return "polygon", convex_hull(vertices[:, :2], decimals=9)
 
     # --- distances ----------------------------------------------------------------------
     def distance(self, points, within=np.inf):

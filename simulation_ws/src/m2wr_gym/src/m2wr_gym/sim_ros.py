@@ -26,6 +26,8 @@ import threading
 
 import numpy as np
 
+from pybullet_gazebo.engine.transforms import yaw_from_quaternion
+
 from .sim_inprocess import REST_Z, ROBOT, Snapshot, robot_urdf
 
 SCAN_TOPIC = "/m2wr/laser/scan"
@@ -230,7 +232,7 @@ class RosSim:
                 time.sleep(0.001)
             p, q = odom.pose.pose.position, odom.pose.pose.orientation
             x, y = p.x, p.y
-            yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+            yaw = yaw_from_quaternion((q.x, q.y, q.z, q.w))
         ranges = np.array(msg.ranges, dtype=np.float32)
         return Snapshot(ranges, float(msg.range_max), float(x), float(y), float(yaw),
                         msg.header.stamp.to_sec(), touched)

@@ -14,6 +14,8 @@ Both are truncated after max_episode_seconds of sim time.
 """
 import math
 
+from pybullet_gazebo.engine.transforms import wrap_angle
+
 NEAR_DISTANCE = 0.6        # [m] of laser range
 NEAR_WEIGHT = 0.05         # per step at contact distance
 CONTACT_PENALTY = 5.0
@@ -28,8 +30,7 @@ def near_penalty(nearest):
 
 def forward_distance(before, after):
     """Displacement [m] from pose `before` to `after` ((x, y, yaw)) along the mean heading."""
-    heading = before[2] + math.atan2(math.sin(after[2] - before[2]),
-                                     math.cos(after[2] - before[2])) / 2.0
+    heading = before[2] + wrap_angle(after[2] - before[2]) / 2.0
     return (after[0] - before[0]) * math.cos(heading) + (after[1] - before[1]) * math.sin(heading)
 
 
