@@ -107,6 +107,13 @@ M2WR_BAD = {
     "mesh file missing": (('<cylinder length="0.04" radius="0.1"/>',
                            '<mesh filename="package://nowhere/wheel.stl"/>'),
                           "Bullet could not load the URDF"),
+    "laser samples zero": (("<samples>720</samples>", "<samples>0</samples>"),
+                           "ray sensor 'head_hokuyo_sensor' on link 'sensor_laser': <samples> "
+                           "is 0; it must be >= 1"),
+    "laser range max below min": (("<max>10.0</max>", "<max>0.05</max>"),
+                                  "<range/max> is 0.05; it must be > 0.1"),
+    "laser noise negative": (("<stddev>0.01</stddev>", "<stddev>-0.01</stddev>"),
+                             "<noise/stddev> is -0.01; it must be >= 0.0"),
 }
 
 

@@ -76,3 +76,14 @@ def test_node_parameters_are_read_and_checked_by_the_same_reader():
     assert SimulatorParams.from_values({"watch_rate": 0}).watch_rate == 0.0  # no limit
     with pytest.raises(ParameterError, match=r"~watch_rate is -5; it must be >= 0"):
         SimulatorParams.from_values({"watch_rate": -5})
+
+
+def test_a_word_parameter_takes_one_of_its_words_and_names_them_when_not():
+    read = ParameterReader({"a": " SDF", "b": True, "c": "maybe"}, "/gazebo", "~%s",
+                           booleans=ROS_BOOLEANS)
+    assert read.choice("a", "x", ("sdf", "true", "false")) == "sdf"
+    assert read.choice("b", "x", ("sdf", "true", "false")) == "true"    # roslaunch's bool
+    assert read.choice("d", "sdf", ("sdf", "true", "false")) == "sdf"
+    with pytest.raises(ParameterError) as err:
+        SimulatorParams.from_values({"gui_rays": "maybe"}, where="/gazebo")
+    assert str(err.value) == "/gazebo: ~gui_rays is maybe; write one of: sdf, true, false"

@@ -79,3 +79,14 @@ class ParameterReader:
         if word in self.booleans[1]:
             return False
         self._fail(key, raw, "write true or false")
+
+    def choice(self, key, default, choices):
+        """One of the words `choices` (lower case; a boolean reads as true/false, as roslaunch
+        hands over `value="true"`)."""
+        raw = self.values.get(key)
+        if raw is None:
+            return default
+        word = str(raw).strip().lower()
+        if word not in choices:
+            self._fail(key, raw, "write one of: %s" % ", ".join(choices))
+        return word

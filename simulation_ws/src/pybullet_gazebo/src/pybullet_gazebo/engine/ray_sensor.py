@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import ray_kernel
+from .parameters import ParameterReader
 from .part import Part, PartContext, next_period_time
 from .transforms import Pose
 
@@ -94,20 +95,20 @@ class RaySensor(Part):
 
     @staticmethod
     def _check(spec):
-        where = "ray sensor '%s' on link '%s'" % (spec.name, spec.link)
-        if int(spec.samples) < 1:
-            raise ValueError("%s: <samples> is %s; it must be at least 1" % (where, spec.samples))
-        if not spec.max_angle >= spec.min_angle:
-            raise ValueError("%s: <max_angle> %s is below <min_angle> %s"
-                             % (where, spec.max_angle, spec.min_angle))
-        if not 0.0 <= spec.range_min < spec.range_max:
-            raise ValueError("%s: range must satisfy 0 <= <min> < <max>; got %s .. %s"
-                             % (where, spec.range_min, spec.range_max))
-        if not spec.update_rate >= 0.0:
-            raise ValueError("%s: <update_rate> %s must be >= 0 (0 = every step)"
-                             % (where, spec.update_rate))
-        if not spec.noise_stddev >= 0.0:
-            raise ValueError("%s: noise <stddev> %s must be >= 0" % (where, spec.noise_stddev))
+        """The sensor's values Gazebo could not run are refused (ParameterError, a
+        ValueError), naming the tag, its value and the allowed range."""
+        read = ParameterReader({"samples": spec.samples, "max_angle": spec.max_angle,
+                                "range/min": spec.range_min, "range/max": spec.range_max,
+                                "update_rate": spec.update_rate,
+                                "noise/stddev": spec.noise_stddev},
+                               "ray sensor '%s' on link '%s'" % (spec.name, spec.link),
+                               label="<%s>")
+        read.integer("samples", 1, minimum=1)
+        read.number("max_angle", 0.0, minimum=spec.min_angle)      # [rad]
+        read.number("range/min", 0.0, minimum=0.0)                 # [m]
+        read.number("range/max", 0.0, above=spec.range_min)        # [m]
+        read.number("update_rate", 0.0, minimum=0.0)               # [Hz]; 0 = every step
+        read.number("noise/stddev", 0.0, minimum=0.0)              # [m]
 
     def reset(self):
         """After a simulation reset: the next call to due() is true."""

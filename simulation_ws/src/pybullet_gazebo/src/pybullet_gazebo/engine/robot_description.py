@@ -6,7 +6,9 @@ what Gazebo would take from it beyond links and joints, and cleans it for pybull
   libgazebo_ros_laser.so plugin, `<mu1>`/`<mu2>` per link) and the SDF-style
   `<surface><friction><ode><mu>/<mu2>` written inside URDF `<collision>` elements.
   Anything it does not simulate becomes a warning naming the tag (`RobotSpec.warnings`);
-  a description it cannot use raises `RobotDescriptionError` saying what and where.
+  a description it cannot use raises `RobotDescriptionError` saying what and where. A
+  plugin's or sensor's values are range-checked by the part that reads them, when it is
+  built (engine/parameters.py's ParameterReader), not here.
 - `bullet_tree(spec)` -> a copy of the parsed URDF with only URDF elements left (no `<gazebo>`
   blocks, no link `<pose>`, no collision `<surface>`), for `loadURDF`; `strip_for_bullet(spec)`
   is the same as text.
@@ -399,8 +401,7 @@ def _ray_sensor(sensor, link, warnings):
         resolution=_number(ray, "range/resolution", where, defaults.resolution),
         noise_mean=_number(ray, "noise/mean", where, defaults.noise_mean),
         noise_stddev=_number(ray, "noise/stddev", where, defaults.noise_stddev),
-        plugin=None)
-    _check_ray(spec, where)
+        plugin=None)      # the ranges of these values: RaySensor._check, when it is built
 
     if _number(ray, horizontal + "resolution", where, 1.0) != 1.0:
         warnings.append("%s <scan><horizontal><resolution> other than 1 is not simulated; "
@@ -424,26 +425,6 @@ def _ray_sensor(sensor, link, warnings):
             warnings.append("%s <%s> is not supported by the stand-in; ignored"
                             % (where, child.tag))
     return dataclasses.replace(spec, plugin=plugin)
-
-
-def _check_ray(spec, where):
-    problems = []
-    if spec.samples < 1:
-        problems.append("<samples> is %d; it must be 1 or more" % spec.samples)
-    if spec.max_angle < spec.min_angle:
-        problems.append("<max_angle> %g is below <min_angle> %g" % (spec.max_angle,
-                                                                     spec.min_angle))
-    if not 0.0 <= spec.range_min < spec.range_max:
-        problems.append("range <min> %g and <max> %g must satisfy 0 <= min < max"
-                        % (spec.range_min, spec.range_max))
-    if spec.update_rate < 0.0:
-        problems.append("<update_rate> is %g; it must be 0 (every step) or more"
-                        % spec.update_rate)
-    if spec.noise_stddev < 0.0:
-        problems.append("noise <stddev> is %g; it must be 0 or more" % spec.noise_stddev)
-    if problems:
-        raise RobotDescriptionError("%s %s; fix the <gazebo> block" % (where,
-                                                                     "; ".join(problems)))
 
 
 def _collision_friction(root):

@@ -81,7 +81,7 @@ class SimulatorParams:
             cmd_vel_timeout=read.number("cmd_vel_timeout", d.cmd_vel_timeout, minimum=0.0),
             gui=read.boolean("gui", d.gui),
             gui_fps=read.number("gui_fps", d.gui_fps, above=0.0),
-            gui_rays=_gui_rays(read, d.gui_rays),
+            gui_rays=read.choice("gui_rays", d.gui_rays, ("sdf", "true", "false")),
             gui_follow=read.boolean("gui_follow", d.gui_follow),
             debug=read.boolean("debug", d.debug),
             legacy_mode=read.boolean("legacy_mode", d.legacy_mode),
@@ -95,11 +95,3 @@ class SimulatorParams:
                                            rospy.get_param("/use_sim_time", True),
                                            where=rospy.get_name())
 
-
-def _gui_rays(read, default):
-    """~gui_rays: sdf, true or false (roslaunch hands true/false over as booleans)."""
-    raw = read.values.get("gui_rays")
-    value = default if raw is None else str(raw).strip().lower()
-    if value not in ("sdf", "true", "false"):
-        raise ParameterError("~gui_rays = %r is invalid: expected sdf, true or false" % raw)
-    return value
