@@ -16,6 +16,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from pybullet_gazebo.engine import appearance
 from pybullet_gazebo.engine.diff_drive import DiffDrive
+from pybullet_gazebo.engine.robot_description import parse_robot
 from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
 from pybullet_gazebo.engine.transforms import Pose
 from pybullet_gazebo.engine.world import World
@@ -115,6 +116,14 @@ def test_beams_are_sent_when_asked_and_end_at_the_returns(tmp_path, world02, m2w
     assert origin[2] == pytest.approx(0.15, abs=0.02)        # the laser's height on m2wr
 
 
+def test_gui_rays_sdf_draws_a_laser_whose_description_says_visualize_true(tmp_path, world02,
+                                                                         m2wr_urdf):
+    urdf = m2wr_urdf.replace("<visualize>false</visualize>", "<visualize>true</visualize>")
+    assert urdf != m2wr_urdf
+    messages, _ = run_window(tmp_path, world02, urdf, rays="sdf")
+    assert [m for m in messages if m[0] == "frame" and m[5]]
+
+
 def test_a_display_that_cannot_be_opened_gives_a_warning_and_no_window(monkeypatch, world02):
     monkeypatch.setenv("DISPLAY", ":4321")
     warnings = []
@@ -124,10 +133,11 @@ def test_a_display_that_cannot_be_opened_gives_a_warning_and_no_window(monkeypat
 
 
 def test_gazebo_and_urdf_colours(m2wr_urdf):
-    colours = appearance.urdf_link_colours(m2wr_urdf)
+    description = parse_robot(m2wr_urdf, "m2wr")
+    colours = appearance.urdf_link_colours(description.urdf)
     assert colours["link_chassis"] == appearance.GAZEBO_MATERIALS["Gazebo/Orange"]
     assert colours["link_left_wheel"] == (0.0, 0.0, 1.0, 1.0)        # Gazebo/Blue wins
-    assert appearance.urdf_sensors_visualized(m2wr_urdf) == {"head_hokuyo_sensor": False}
+    assert {s.name: s.visualize for s in description.sensors} == {"head_hokuyo_sensor": False}
     path = os.path.join(SRC, "my_worlds", "worlds", "world02.world")
     spec = load_world(path, model_path_from_env(os.path.join(SRC, "pybullet_gazebo", "models")))
     by_name = {m.name: m.links[0].colour for m in spec.models}

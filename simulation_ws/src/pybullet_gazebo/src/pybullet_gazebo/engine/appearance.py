@@ -1,5 +1,5 @@
-"""What things look like: colours of SDF and URDF materials, and which sensors Gazebo would
-draw. Data only (no pybullet, no ROS); the GUI (pybullet_gazebo.gui) paints with it.
+"""What things look like: colours of SDF and URDF materials (which sensors Gazebo would draw:
+RaySensorSpec.visualize). Data only (no pybullet, no ROS); the GUI (pybullet_gazebo.gui) paints with it.
 
 Colours are RGBA in 0..1. Gazebo's material scripts are named in `<material><script><name>`
 (SDF) or `<gazebo reference="link"><material>` (URDF); GAZEBO_MATERIALS holds the diffuse
@@ -82,10 +82,9 @@ def sdf_link_colour(link) -> Optional[RGBA]:
     return None
 
 
-def urdf_link_colours(urdf_xml: str) -> Dict[str, RGBA]:
-    """{link name: colour} for the links of a URDF text that name one (see the module
-    docstring for which wins)."""
-    root = ET.fromstring(urdf_xml)
+def urdf_link_colours(root: ET.Element) -> Dict[str, RGBA]:
+    """{link name: colour} for the links of a parsed URDF (RobotSpec.urdf) that name one (see
+    the module docstring for which wins)."""
     named = {}                                     # top-level <material name> -> colour
     for material in root.findall("material"):
         colour = _floats(material.find("color").get("rgba")) \
@@ -106,14 +105,3 @@ def urdf_link_colours(urdf_xml: str) -> Dict[str, RGBA]:
         if link and name in GAZEBO_MATERIALS:
             colours[link] = GAZEBO_MATERIALS[name]
     return colours
-
-
-def urdf_sensors_visualized(urdf_xml: str) -> Dict[str, bool]:
-    """{sensor name: its `<visualize>` flag} for the `<sensor>`s of a URDF's `<gazebo>`
-    blocks (Gazebo draws a ray sensor's beams only when it is true; default false)."""
-    root = ET.fromstring(urdf_xml)
-    flags = {}
-    for sensor in root.findall("gazebo/sensor"):
-        text = (sensor.findtext("visualize") or "false").strip().lower()
-        flags[sensor.get("name")] = text in ("true", "1")
-    return flags

@@ -66,7 +66,7 @@ _URDF_CHILDREN = {
 }
 
 # Children of a <sensor> that change nothing the stand-in simulates.
-_SENSOR_TAGS_IGNORED = {"visualize", "always_on", "topic"}
+_SENSOR_TAGS_IGNORED = {"always_on", "topic"}
 
 
 def parse_robot(urdf_xml: str, model_name: str) -> RobotSpec:
@@ -401,7 +401,8 @@ def _ray_sensor(sensor, link, warnings):
         resolution=_number(ray, "range/resolution", where, defaults.resolution),
         noise_mean=_number(ray, "noise/mean", where, defaults.noise_mean),
         noise_stddev=_number(ray, "noise/stddev", where, defaults.noise_stddev),
-        plugin=None)      # the ranges of these values: RaySensor._check, when it is built
+        plugin=None,      # the ranges of these values: RaySensor._check, when it is built
+        visualize=(sensor.findtext("visualize") or "false").strip().lower() in ("true", "1"))
 
     if _number(ray, horizontal + "resolution", where, 1.0) != 1.0:
         warnings.append("%s <scan><horizontal><resolution> other than 1 is not simulated; "
@@ -421,7 +422,7 @@ def _ray_sensor(sensor, link, warnings):
             else:
                 warnings.append("%s a second <plugin> (%s) is ignored; one per sensor"
                                 % (where, child.get("filename", "")))
-        elif child.tag not in {"pose", "update_rate", "ray"} | _SENSOR_TAGS_IGNORED:
+        elif child.tag not in {"pose", "update_rate", "ray", "visualize"} | _SENSOR_TAGS_IGNORED:
             warnings.append("%s <%s> is not supported by the stand-in; ignored"
                             % (where, child.tag))
     return dataclasses.replace(spec, plugin=plugin)

@@ -133,6 +133,7 @@ class RaySensorSpec:
     noise_mean: float = 0.0                   # [m]
     noise_stddev: float = 0.0                 # [m]
     plugin: Optional[PluginSpec] = None       # libgazebo_ros_laser.so: topicName, frameName
+    visualize: bool = False                   # <visualize>: Gazebo's GUI draws its beams
 
 
 @dataclass(frozen=True)

@@ -143,10 +143,11 @@ class Viewer:
 
     def _build_robot(self, name, urdf_xml):
         self.remove(name)
+        description = parse_robot(urdf_xml, name)     # the text's one parse in this process
         handle, path = tempfile.mkstemp(prefix="pybullet_gazebo_view_", suffix=".urdf")
         try:
             with os.fdopen(handle, "w") as out:
-                out.write(strip_for_bullet(parse_robot(urdf_xml, name)))
+                out.write(strip_for_bullet(description))
             body = self.client.loadURDF(path, useFixedBase=True,
                                         flags=pybullet.URDF_USE_IMPLICIT_CYLINDER)
         finally:
@@ -158,7 +159,7 @@ class Viewer:
             links[info[12].decode()] = index
         root = self.client.getBodyInfo(body)[0].decode()
         links[root] = -1
-        for link, colour in urdf_link_colours(urdf_xml).items():
+        for link, colour in urdf_link_colours(description.urdf).items():
             if link in links:
                 self.client.changeVisualShape(body, links[link], rgbaColor=colour)
         inertial = Pose(*self.client.getDynamicsInfo(body, -1)[3:5])

@@ -23,7 +23,6 @@ import time
 
 import numpy as np
 
-from ..engine.appearance import urdf_sensors_visualized
 from ..engine.ray_sensor import RaySensor
 from ..engine.transforms import Pose
 from .display import display_problem
@@ -85,10 +84,8 @@ class GuiWindow:
 
     # --- what the simulator tells it --------------------------------------------------
     def add_robot(self, robot, urdf_xml):
-        flags = urdf_sensors_visualized(urdf_xml)
         sensors = [c for c in robot.parts_with(RaySensor.KEY)
-                   if self.rays == "true"
-                   or (self.rays == "sdf" and flags.get(c.spec.name, False))]
+                   if self.rays == "true" or (self.rays == "sdf" and c.spec.visualize)]
         self._robots[robot.name] = (robot, sensors)
         self._send(("robot", robot.name, urdf_xml))
 
