@@ -24,7 +24,7 @@ import time
 
 from . import processes
 from .processes import Interrupted, raise_on_signals
-from .names import CONTACTS_TOPIC, SPAWN_LAUNCH
+from .names import CONTACTS_TOPIC, ROSOUT_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH
 from .session import Session, SessionError
 
 # world: (legacy_mode, the controllers' turn_sign, goal), as bug2_world02/03.test run them
@@ -56,7 +56,7 @@ class RunWatch:
         self.contact_events = []           # (sim [s], robot, model)
         self.lockstep_timeouts = []        # wall [s] each `no cmd_vel within` was heard
         self._touching = set()
-        self._subs = [rospy.Subscriber("/rosout", Log, self._on_log, queue_size=1000),
+        self._subs = [rospy.Subscriber(ROSOUT_TOPIC, Log, self._on_log, queue_size=1000),
                       rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self._on_contacts,
                                        queue_size=1000)]
 
@@ -115,7 +115,7 @@ def run_world(session, world, sim_limit, wall_limit):
                                % controllers.log_path)
         time.sleep(0.02)
     placed = watch.first("robot placed")
-    simulator_pid = session.node_pid("/gazebo")
+    simulator_pid = session.node_pid(SIMULATOR_NODE)
     controller_pids = [p for p in (session.node_pid(n) for n in
                                    ("/bug2", "/go_to_point", "/wall_follower")) if p]
     cpu_start = (processes.cpu_seconds(simulator_pid),

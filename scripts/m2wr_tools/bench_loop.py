@@ -11,7 +11,8 @@ from . import benchmath, processes
 from .benchmath import fmt
 from .gazebo import call_empty
 from .names import (CLOCK_TOPIC, COMMAND_TOPIC, CONTACTS_TOPIC, CONTROLLER_NODE, DEFAULT_START,
-                    DEFAULT_WORLD, PAUSE_SERVICE, SCAN_TOPIC, SIMULATOR_NODE, TF_TOPIC,
+                    DEFAULT_WORLD, JOINT_STATES_TOPIC, MODEL_STATES_TOPIC, PAUSE_SERVICE,
+                    ROSOUT_TOPIC, SCAN_TOPIC, SIMULATOR_NODE, SPAWN_SERVICE, TF_TOPIC,
                     UNPAUSE_SERVICE)
 from .session import SessionError
 from .summary import is_case
@@ -66,7 +67,7 @@ class Listener:
         if commands:
             self._subs.append(rospy.Subscriber(COMMAND_TOPIC, Twist, self._on_command,
                                                queue_size=10000, tcp_nodelay=True))
-            self._subs.append(rospy.Subscriber("/rosout", Log, self._on_log, queue_size=10000))
+            self._subs.append(rospy.Subscriber(ROSOUT_TOPIC, Log, self._on_log, queue_size=10000))
 
     def snapshot(self):
         """(scans heard, cmd_vel answers, controller case lines) so far."""
@@ -129,10 +130,10 @@ def start_loop(session, lockstep, clock_hz, extra=()):
 # their own deserializing. None reads the scan or /odom: they are watchers, and get /clock
 # limited in wall time (clock_topic.py).
 WATCHERS = {
-    "watch_model_states": ["rostopic", "hz", "/gazebo/model_states"],
+    "watch_model_states": ["rostopic", "hz", MODEL_STATES_TOPIC],
     "robot_state_publisher": ["rosrun", "robot_state_publisher", "robot_state_publisher"],
     "watch_tf": ["rostopic", "hz", TF_TOPIC],
-    "watch_joint_states": ["rostopic", "hz", "/joint_states"],
+    "watch_joint_states": ["rostopic", "hz", JOINT_STATES_TOPIC],
 }
 
 
@@ -235,7 +236,7 @@ def launch_to_first_scan(session, listener, clock_hz, timeout=60.0):
         service_up = None
         deadline = t0 + timeout
         while time.monotonic() < deadline and not listener.wait_first_scan(0.02):
-            if service_up is None and session.service_offered("/gazebo/spawn_urdf_model"):
+            if service_up is None and session.service_offered(SPAWN_SERVICE):
                 service_up = time.monotonic() - t0
             session.check_running(["world"])
         if listener.first_scan_wall is None:

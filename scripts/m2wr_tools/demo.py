@@ -26,7 +26,8 @@ import time
 from . import processes, summary
 from .processes import Interrupted, raise_on_signals
 from .names import (COMMAND_TOPIC, CONTROLLER_NODE, DEFAULT_START, DEFAULT_WORLD, ODOM_TOPIC,
-                    PAUSE_SERVICE, SCAN_TOPIC, SIMULATOR_NODE, UNPAUSE_SERVICE)
+                    PAUSE_SERVICE, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC, SIMULATOR_NODE,
+                    UNPAUSE_SERVICE)
 from .paths import ROOT
 from .scene import SCAN_HEIGHT
 from .session import Session, SessionError
@@ -107,7 +108,7 @@ def run(args, session, paths):
     session.start_episode(args.world, (args.x, args.y, args.yaw), lockstep=not realtime,
                           real_time_factor=1.0 if realtime else 0.0, seed=args.seed,
                           pub_clock_frequency=args.clock_hz, gui=args.gui, say=say)
-    urdf = rospy.get_param("/robot_description")
+    urdf = rospy.get_param(ROBOT_DESCRIPTION_PARAM)
     if args.bag:
         session.start_bag(paths["bag"], BAG_TOPICS)
         _wait_for_bag(session)

@@ -16,6 +16,9 @@ TF_TOPIC = "/tf"                           # tf2_msgs/TFMessage: odom -> link_ch
 BASE_FRAME = "link_chassis"                # m2wr's base frame (the diff drive's robotBaseFrame)
 CONTACTS_TOPIC = "/gazebo/contacts"        # gazebo_msgs/ContactsState: what the robot touches
 ROSOUT_TOPIC = "/rosout"                   # rosgraph_msgs/Log, each node's log lines
+MODEL_STATES_TOPIC = "/gazebo/model_states"  # gazebo_msgs/ModelStates
+JOINT_STATES_TOPIC = "/joint_states"       # sensor_msgs/JointState: m2wr's wheels
+ROBOT_DESCRIPTION_PARAM = "/robot_description"   # m2wr's URDF, as spawn.launch sets it
 
 # services (Gazebo's names and types)
 SPAWN_SERVICE = "/gazebo/spawn_urdf_model"

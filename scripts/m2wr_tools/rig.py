@@ -56,8 +56,8 @@ import numpy as np
 from . import metrics, processes
 from .gazebo import Services, model_poses
 from .names import (BASE_FRAME, COMMAND_TOPIC, CONTACTS_TOPIC, ODOM_TOPIC, PAUSE_SERVICE,
-                    RESET_SIMULATION_SERVICE, ROBOT, SCAN_TOPIC, SIMULATOR_NODE, TF_TOPIC,
-                    UNPAUSE_SERVICE)
+                    RESET_SIMULATION_SERVICE, ROBOT, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC,
+                    SIMULATOR_NODE, TF_TOPIC, UNPAUSE_SERVICE)
 from .scenarios import Scenario
 from .session import Session, SessionError, python_logging_config
 
@@ -195,7 +195,7 @@ class Rig:
         if world not in self.scenes:
             import rospy
             from .scene import Scene
-            self.scenes[world] = Scene.of_world(world, rospy.get_param("/robot_description"))
+            self.scenes[world] = Scene.of_world(world, rospy.get_param(ROBOT_DESCRIPTION_PARAM))
         return self.scenes[world]
 
     # --- one run ------------------------------------------------------------------------
