@@ -73,3 +73,27 @@ def test_a_joint_state_plugin_naming_a_missing_joint_is_refused(world, m2wr_urdf
     with pytest.raises(SpawnError, match="joint_wheel_3.*joint_left_wheel"):
         world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(0, 0, 0.5))
     assert "m2wr" not in world.model_names()
+
+
+def test_the_drive_s_publish_wheel_flags_work_or_are_reported(m2wr_urdf):
+    """publishWheelJointState: the wheel states come whatever it says (rviz needs them);
+    publishWheelTF true: not simulated, and the warning says so by name."""
+    warnings = []
+    client = BulletClient(connection_mode=pybullet.DIRECT)
+    try:
+        path = os.path.join(SRC, "pybullet_gazebo", "worlds", "empty.world")
+        world = World(client, load_world(path, model_path_from_env(
+            os.path.join(SRC, "pybullet_gazebo", "models"))), STEP, warn=warnings.append)
+        flags = ("<legacyMode>false</legacyMode><publishWheelTF>true</publishWheelTF>"
+                 "<publishWheelJointState>true</publishWheelJointState>")
+        urdf = m2wr_urdf.replace("<legacyMode>false</legacyMode>", flags)
+        assert urdf != m2wr_urdf
+        robot = world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(0, 0, 0.5))
+        (states,) = robot.parts_with(JointStatePublisher.KEY)
+        assert states.names == ("joint_left_wheel", "joint_right_wheel")
+        reported = [w for w in warnings if "publishWheelTF" in w]
+        assert len(reported) == 1 and "not simulated" in reported[0]
+        assert reported[0].startswith("model 'm2wr': ")
+        assert not any("publishWheelJointState" in w for w in warnings)
+    finally:
+        client.disconnect()
