@@ -12,7 +12,7 @@ WORLD, START = DEFAULT_WORLD, DEFAULT_START
 def engine_figures(steps=2000, scans=300):
     """Physics and scan costs of world02 + m2wr in a DIRECT client, no ROS."""
     import pybullet
-    from pybullet_utils.bullet_client import BulletClient
+    from pybullet_gazebo.engine.client import Client
     from pybullet_gazebo.engine.diff_drive import DiffDrive
     from pybullet_gazebo.engine.ray_sensor import RaySensor
     from pybullet_gazebo.engine.sdf_world import load_world
@@ -23,7 +23,7 @@ def engine_figures(steps=2000, scans=300):
     spec = load_world(paths.world_path(WORLD), paths.model_path())
     urdf = paths.robot_urdf()
     step = 0.005      # [s] the simulator's default max_step_size
-    client = BulletClient(connection_mode=pybullet.DIRECT)
+    client = Client(connection_mode=pybullet.DIRECT)
     try:
         world = World(client, spec, step, warn=lambda _m: None)
         robot = world.spawn_urdf(ROBOT, urdf, Pose.from_xyz_rpy(START[0], START[1], 0.5,

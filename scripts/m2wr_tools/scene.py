@@ -20,7 +20,7 @@ from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 import pybullet
-from pybullet_utils.bullet_client import BulletClient
+from pybullet_gazebo.engine.client import Client
 
 from pybullet_gazebo.engine import wheel_contact
 from pybullet_gazebo.engine.planar import convex_hull
@@ -108,7 +108,7 @@ class Scene:
 
     def __init__(self, world_path, model_path, urdf_xml, robot=ROBOT):
         self.spec = load_world(world_path, model_path)
-        self.client = BulletClient(connection_mode=pybullet.DIRECT)
+        self.client = Client(connection_mode=pybullet.DIRECT)
         self.warnings = []
         self.world = World(self.client, self.spec, self.spec.physics.max_step_size or 0.001,
                            warn=self.warnings.append)

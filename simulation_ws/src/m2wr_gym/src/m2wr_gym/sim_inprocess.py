@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pybullet
-from pybullet_utils.bullet_client import BulletClient
+from pybullet_gazebo.engine.client import Client
 
 from pybullet_gazebo.engine.diff_drive import DiffDrive
 from pybullet_gazebo.engine.ray_sensor import RaySensor
@@ -56,7 +56,7 @@ class InProcessSim:
         self.legacy_mode = legacy_mode            # the simulator's legacy_mode:=true
         self.urdf = robot_urdf(laser_noise)
         self.warnings = []
-        self.client = BulletClient(connection_mode=pybullet.GUI if gui else pybullet.DIRECT)
+        self.client = Client(connection_mode=pybullet.GUI if gui else pybullet.DIRECT)
         if gui:
             self.client.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0)
         self.world = None

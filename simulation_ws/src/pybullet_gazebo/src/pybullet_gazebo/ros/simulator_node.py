@@ -33,7 +33,7 @@ import pybullet
 import rospy
 from gazebo_msgs.msg import ContactState, ContactsState
 from tf2_msgs.msg import TFMessage
-from pybullet_utils.bullet_client import BulletClient
+from pybullet_gazebo.engine.client import Client
 
 from pybullet_gazebo.engine.world import World
 from pybullet_gazebo.gui.window import open_window
@@ -57,7 +57,7 @@ class SimulatorNode:
         self.params = params
         self.model_path = list(model_path)        # for spawn_sdf_model's model:// includes
         # Physics always in DIRECT mode; the window is a viewer process of its own (gui/)
-        self.client = BulletClient(connection_mode=pybullet.DIRECT)
+        self.client = Client(connection_mode=pybullet.DIRECT)
         step = params.max_step_size or world_spec.physics.max_step_size
         self.world = World(self.client, world_spec, step, seed=params.seed,
                            warn=lambda m: rospy.logwarn(m),
