@@ -65,6 +65,7 @@ import json
 import math
 import os
 import platform
+import statistics
 import sys
 
 from . import benchmath
@@ -210,7 +211,7 @@ def rounds_report(figures):
                          ", ".join("%s %s" % (n, fmt(v, "%.1f"))
                                    for n, v in cpu1["each_listener"].items()), pair["load"]))
     if ratios:
-        lines.append("  median: %.0f %% (target >= 90 %%)" % sorted(ratios)[len(ratios) // 2])
+        lines.append("  median: %.0f %% (target >= 90 %%)" % statistics.median(ratios))
     return "\n".join(lines)
 
 

@@ -110,3 +110,23 @@ def test_the_wall_time_limit_skips_messages(world):
         topics.publish()
     sent = len(topics.model_states.publisher.sent)
     assert 1 <= sent < 200 and topics.skipped() >= 2 * (200 - sent)
+
+
+def test_wanted_says_whether_a_due_message_would_go_out(world):
+    # the loop steps past model_states' due steps while wanted() is false (faster than
+    # real time, the limit would skip them): it must be false exactly then
+    topics = state_topics.StateTopics(world, wall_limit=30.0)
+    wall = [100.0]
+    for message in (topics.model_states, topics.link_states):
+        message.limit._clock = lambda: wall[0]
+    answers = []
+    for _ in range(40):                  # all at one wall instant: the burst, then none
+        world.step()
+        wanted = topics.wanted()
+        before = len(topics.model_states.publisher.sent)
+        topics.publish()
+        assert (len(topics.model_states.publisher.sent) > before) == wanted
+        answers.append(wanted)
+    assert answers[0] and not answers[-1]
+    wall[0] += 1.5 / 30.0                # over one message's worth of wall time later
+    assert topics.wanted()

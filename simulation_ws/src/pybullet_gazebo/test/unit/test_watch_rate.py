@@ -78,3 +78,26 @@ def test_topic_limit_never_below_the_topics_own_rate():
     assert topic_limit(30.0, 100.0) == 100.0      # a joint_state_publisher at 100 Hz
     assert topic_limit(30.0, math.inf) == 0.0     # every step: not limited
     assert topic_limit(0.0, 20.0) == 0.0
+
+
+def test_ready_foretells_allow_and_takes_nothing():
+    # the loop asks ready() to decide whether to stop at the next model_states step: it
+    # must say what allow() would say at that moment, and asking must not use up the limit
+    clock = FakeClock()
+    gate = WallRateLimit(50.0, clock=clock)
+    asked = WallRateLimit(50.0, clock=clock)
+    rng = random.Random(4)
+    t = 0.0
+    for _ in range(5000):
+        t += rng.expovariate(300.0)              # ~300 calls per wall second: limited
+        clock.now = 100.0 + t
+        for _ in range(3):
+            expected = asked.ready()
+        assert asked.allow() == expected
+        assert gate.allow() == expected          # the twin that was never asked
+    assert 0 < gate.skipped == asked.skipped < 5000
+
+
+def test_ready_without_a_limit_is_always_true():
+    gate = WallRateLimit(0.0, clock=FakeClock())
+    assert all(gate.ready() for _ in range(10))

@@ -76,6 +76,10 @@ class _StatesMessage:
     def heard(self):
         return self.publisher.get_num_connections() > 0
 
+    def wanted(self):
+        """Someone listens and the wall-time limit would let a message through now."""
+        return self.heard() and self.limit.ready()
+
 
 class StateTopics:
     def __init__(self, world, wall_limit=0.0):
@@ -87,6 +91,12 @@ class StateTopics:
 
     def heard(self):
         return self.model_states.heard() or self.link_states.heard()
+
+    def wanted(self):
+        """A message would go out now if one were due: someone listens to a topic whose
+        wall-time limit lets one through (the loop steps up to the next due step only then;
+        see SimulatorNode._steps_ahead)."""
+        return self.model_states.wanted() or self.link_states.wanted()
 
     def publish(self):
         """Publishes the topics someone listens to. Call with the world's lock held."""

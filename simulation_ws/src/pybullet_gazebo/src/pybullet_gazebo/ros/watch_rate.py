@@ -42,6 +42,15 @@ class WallRateLimit:
         self._last = None
         self.skipped = 0                    # calls refused so far
 
+    def ready(self):
+        """True when a call now would pass (allow() would say True); takes nothing."""
+        if self.limit == 0.0:
+            return True
+        tokens = self._tokens
+        if self._last is not None:
+            tokens = min(self._capacity, tokens + (self._clock() - self._last) * self.limit)
+        return tokens >= 1.0
+
     def allow(self):
         if self.limit == 0.0:
             return True
