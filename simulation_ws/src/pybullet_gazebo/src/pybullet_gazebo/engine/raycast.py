@@ -352,16 +352,10 @@ class RayCaster:
         directions = ray_kernel.unit_rows(directions, norms)
         if directions is None:
             raise ValueError("RayCaster.cast: every direction must be a finite non-zero vector")
-        range_min = max(0.0, float(range_min))
-        range_max = float(range_max)
-        result = np.full(len(directions), np.inf)
-        if not range_min < range_max or len(directions) == 0:
-            return result
-
         normal = self._coplanar_normal(directions)
         fan = ray_kernel.NO_FAN if fan is None or normal is None else _fan_array(fan, directions)
         return self._nearest(origin, directions, normal, fan, range_min, range_max,
-                             exclude_body, result)
+                             exclude_body)
 
     def cast_fan(self, frame, directions, fan, range_min, range_max, exclude_body=None,
                  cull=True):
@@ -369,19 +363,18 @@ class RayCaster:
         origin and x, y, z axes, directions (n, 3) unit vectors in its xy plane, fan (8,)
         the kernels' fan. Distances as cast() gives them; `cull`: try each shape only on
         the beams that can reach it (the same distances to the last bit as without)."""
+        return self._nearest(frame[0], directions, frame[3], fan if cull else ray_kernel.NO_FAN,
+                             range_min, range_max, exclude_body)
+
+    def _nearest(self, origin, directions, normal, fan, range_min, range_max, exclude_body):
+        """The distances to the nearest hits, inf where none (cast's job once its rays are
+        checked): normal, the unit normal of a plane through origin holding every ray, or
+        None; fan, the kernels' fan or NO_FAN."""
         result = np.full(len(directions), np.inf)
         range_min = max(0.0, float(range_min))
         range_max = float(range_max)
         if not range_min < range_max or len(directions) == 0:
             return result
-        return self._nearest(frame[0], directions, frame[3], fan if cull else ray_kernel.NO_FAN,
-                             range_min, range_max, exclude_body, result)
-
-    def _nearest(self, origin, directions, normal, fan, range_min, range_max, exclude_body,
-                 result):
-        """Lowers result to the nearest hits (cast's job once its rays are checked): normal,
-        the unit normal of a plane through origin holding every ray, or None; fan, the
-        kernels' fan or NO_FAN."""
         static_shapes, static_planes, static_meshes = self._static()
         dynamic_shapes, dynamic_planes, dynamic_meshes = self._dynamic(exclude_body)
         for body_id, point, plane_normal in static_planes + dynamic_planes:

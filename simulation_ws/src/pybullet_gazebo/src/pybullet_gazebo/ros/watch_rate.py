@@ -42,21 +42,21 @@ class WallRateLimit:
         self._last = None
         self.skipped = 0                    # calls refused so far
 
+    def _tokens_at(self, now):
+        """The tokens in the bucket at wall time `now`, refilled since the last call."""
+        if self._last is None:
+            return self._tokens
+        return min(self._capacity, self._tokens + (now - self._last) * self.limit)
+
     def ready(self):
         """True when a call now would pass (allow() would say True); takes nothing."""
-        if self.limit == 0.0:
-            return True
-        tokens = self._tokens
-        if self._last is not None:
-            tokens = min(self._capacity, tokens + (self._clock() - self._last) * self.limit)
-        return tokens >= 1.0
+        return self.limit == 0.0 or self._tokens_at(self._clock()) >= 1.0
 
     def allow(self):
         if self.limit == 0.0:
             return True
         now = self._clock()
-        if self._last is not None:
-            self._tokens = min(self._capacity, self._tokens + (now - self._last) * self.limit)
+        self._tokens = self._tokens_at(now)
         self._last = now
         if self._tokens >= 1.0:
             self._tokens -= 1.0
