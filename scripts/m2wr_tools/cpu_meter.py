@@ -7,23 +7,7 @@ With `children=True` the CPU of the process's children that it has reaped counts
 (a zygote's forked controllers once they have exited). A process that is gone at a mark
 counts what it used up to its last mark.
 """
-import os
-import time
-
-_TICK = os.sysconf("SC_CLK_TCK")
-
-
-def cpu_of(pid, children=False):
-    """utime + stime [s] of `pid` (plus cutime + cstime with `children`), None when gone."""
-    try:
-        with open("/proc/%d/stat" % pid) as source:
-            fields = source.read().rsplit(")", 1)[1].split()
-    except (OSError, IndexError):
-        return None
-    ticks = int(fields[11]) + int(fields[12])
-    if children:
-        ticks += int(fields[13]) + int(fields[14])
-    return ticks / _TICK
+from .processes import cpu_seconds
 
 
 class CpuMeter:
@@ -32,7 +16,6 @@ class CpuMeter:
         self.processes = processes
         self.stages = {}                  # stage -> {name: CPU s}
         self._last = {}                   # name -> (pid, CPU s at the last mark)
-        self._started = time.monotonic()
         self._sample()
 
     def _sample(self):
@@ -41,7 +24,7 @@ class CpuMeter:
             pid = pid_of()
             if pid is None:
                 continue
-            now = cpu_of(pid, children)
+            now = cpu_seconds(pid, children)
             if now is None:
                 continue
             last_pid, last = self._last.get(name, (None, 0.0))

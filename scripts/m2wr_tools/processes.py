@@ -208,12 +208,16 @@ def _status_field(pid, field):
     return None
 
 
-def cpu_seconds(pid):
-    """User + system CPU time a process has used [s], or None when it is gone."""
+def cpu_seconds(pid, children=False):
+    """User + system CPU time a process has used [s] (with `children`, plus that of the
+    children it has reaped), or None when it is gone."""
     try:
         with open("/proc/%d/stat" % pid) as source:
             fields = source.read().rsplit(")", 1)[1].split()
-        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+        ticks = int(fields[11]) + int(fields[12])
+        if children:
+            ticks += int(fields[13]) + int(fields[14])
+        return ticks / os.sysconf("SC_CLK_TCK")
     except (OSError, ValueError, IndexError):
         return None
 
