@@ -7,6 +7,7 @@ Bullet's. A triangle mesh goes to Bullet as an OBJ file: a concave triangle mesh
 static body, its convex hull on a dynamic one (Bullet collides concave meshes only when
 static); the ray caster gets its triangles (shape_data).
 """
+import contextlib
 from dataclasses import dataclass
 import os
 import tempfile
@@ -55,7 +56,11 @@ def _create_link_body(client, model, link, collisions):
         kwargs = dict(shapeTypes=[], radii=[], halfExtents=[], lengths=[], planeNormals=[],
                       fileNames=[], meshScales=[], flags=[],
                       collisionFramePositions=[], collisionFrameOrientations=[])
-        with tempfile.TemporaryDirectory(prefix="pybullet_gazebo_mesh_") as folder:
+        # a folder for the OBJ files only when there are meshes: making and removing one
+        # for every link was a third of building world02
+        has_mesh = any(isinstance(c.geometry, TriangleMesh) for c in collisions)
+        with tempfile.TemporaryDirectory(prefix="pybullet_gazebo_mesh_") if has_mesh \
+                else contextlib.nullcontext() as folder:
             for collision in collisions:
                 _append_shape(kwargs, collision, model.static, folder)
             shape = client.createCollisionShapeArray(**kwargs)
@@ -80,7 +85,8 @@ def _create_link_body(client, model, link, collisions):
 
 
 def _append_shape(kwargs, collision, static, folder):
-    """One shape of createCollisionShapeArray; a triangle mesh as an OBJ file in folder."""
+    """One shape of createCollisionShapeArray; a triangle mesh as an OBJ file in folder
+    (None when the link has no triangle mesh)."""
     radius, half, length, normal = 0.0, [0.0, 0.0, 0.0], 0.0, [0.0, 0.0, 1.0]
     file_name, flags = "", 0
     if isinstance(collision.geometry, TriangleMesh):
