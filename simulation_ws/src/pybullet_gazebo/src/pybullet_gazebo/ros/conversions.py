@@ -1,6 +1,9 @@
 """Engine data <-> ROS messages. Every message of one step carries the same stamp."""
+import io
 import math
+import struct
 
+import numpy as np
 import rospy
 from geometry_msgs.msg import Point, Pose as PoseMsg, Quaternion, TransformStamped, Twist, Vector3
 from nav_msgs.msg import Odometry
@@ -36,9 +39,30 @@ def is_finite_twist(msg):
     return all(math.isfinite(v) for v in values)
 
 
+class ScanMessage(LaserScan):
+    """A sensor_msgs/LaserScan (same type, md5sum and bytes on the wire) whose `ranges` may
+    stay the engine's float32 array: written with one tobytes() instead of genpy's
+    tolist() and struct.pack(*ranges), ~30 us of the loop's ~1 ms per scan."""
+    __slots__ = ()
+
+    def serialize(self, buff):
+        ranges, intensities = self.ranges, self.intensities
+        self.ranges, self.intensities = (), ()
+        try:
+            head = io.BytesIO()
+            LaserScan.serialize(self, head)     # everything before the two arrays, then
+        finally:                                # their lengths (0, 0): 8 bytes
+            self.ranges, self.intensities = ranges, intensities
+        buff.write(head.getvalue()[:-8])
+        for values in (ranges, intensities):
+            data = np.asarray(values, dtype="<f4")
+            buff.write(struct.pack("<I", len(data)))
+            buff.write(data.tobytes())
+
+
 def scan_to_msg(scan, stamp, frame_id=None):
     """frame_id: the scan's frame as the ROS side resolved it (None: the sensor's own)."""
-    msg = LaserScan()
+    msg = ScanMessage()
     msg.header.stamp = stamp
     msg.header.frame_id = scan.frame_id if frame_id is None else frame_id
     msg.angle_min = scan.angle_min
@@ -48,7 +72,7 @@ def scan_to_msg(scan, stamp, frame_id=None):
     msg.scan_time = scan.scan_time
     msg.range_min = scan.range_min
     msg.range_max = scan.range_max
-    msg.ranges = scan.ranges.tolist()
+    msg.ranges = scan.ranges
     return msg
 
 
