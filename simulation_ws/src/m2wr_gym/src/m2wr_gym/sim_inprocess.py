@@ -102,13 +102,12 @@ class InProcessSim:
         self._drive.set_command(linear_x, angular_z)
         world = self.world
         scans = self._laser.scans_at([world.time_after(k) for k in range(1, steps + 1)])
-        observed = scans[-1] if scans else steps       # index of the step that casts it
         touched = set()
-        world.advance(observed, collect=(), touched=touched)
-        readings = []
-        if observed < steps:
-            readings = world.advance(1, collect=(self._laser,), touched=touched)
-            world.advance(steps - observed - 1, collect=(), touched=touched)
+        if scans:                                      # cast at the last, skip those before
+            readings = world.advance(steps, collect=(self._laser,), touched=touched,
+                                     collect_from=scans[-1])
+        else:
+            readings = world.advance(steps, collect=(), touched=touched)
         return self._snapshot(readings, tuple(sorted({other for _, other in touched})))
 
     def _snapshot(self, readings, touched):

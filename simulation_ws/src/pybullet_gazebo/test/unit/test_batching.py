@@ -199,7 +199,7 @@ def test_pressed_on_a_barrier_it_steps_one_by_one_and_reads_contacts_after_each(
 
     def read(*args):
         counts["reads"] += 1
-        update(*args)
+        return update(*args)
 
     def counted_hook(*args):
         counts["hooks"] += 1

@@ -27,7 +27,8 @@ class ContactTracker:
     def update(self, client, sim_time, robots: Iterable[Tuple[str, int]],
                owner_of: Dict[int, str], grounds: AbstractSet[str]):
         """Reads Bullet's contact points of each (robot name, body) after a step; touches of
-        the models named in `grounds` are not counted."""
+        the models named in `grounds` are not counted. Returns the (robot, other model)
+        pairs touching now (a set of the tracker's own: read it, do not change it)."""
         if client is not self._client:       # bound once: called after every physics step
             self._client, self._contact_points = client, client.getContactPoints
         touching = set()
@@ -44,6 +45,11 @@ class ContactTracker:
         if touching != self._touching:
             self.changes += 1
         self._touching = touching
+        return touching
+
+    def any_touching(self) -> bool:
+        """True when a robot touched a model (the ground excluded) at the last update."""
+        return bool(self._touching)
 
     def touching(self) -> List[Tuple[str, str]]:
         return sorted(self._touching)

@@ -72,6 +72,7 @@ class World:
         self._settled = None        # layout_version after the last step (batches need one)
         self._single_until = -1     # step count before which advance steps one by one
         self._safe_until = -1       # step count up to which no contact can start
+        self._read_at = -1          # step count at which the contacts were last read
         self._batcher = Batcher(client)
         self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
@@ -137,7 +138,8 @@ class World:
         going on as if they had measured."""
         return self.advance(1, collect)
 
-    def advance(self, steps, collect=True, touched=None, until_news=False) -> List[Reading]:
+    def advance(self, steps, collect=True, touched=None, until_news=False,
+                collect_from=0) -> List[Reading]:
         """`steps` fixed steps, with the same readings (`collect` as for step), contact events,
         sim time and physics, to the last bit, as `steps` calls of step(); stretches in which
         nothing can happen between steps (no part's hook acts, no wrench, no contact can
@@ -145,12 +147,15 @@ class World:
         every (robot, other model) pair touching after any of the steps. `until_news`: stop
         early, after the step that brought readings or changed which robots touch which
         models (a caller that publishes those at once, as the ROS loop does; step_count says
-        how many steps ran)."""
+        how many steps ran). `collect_from`: the readings due in the steps before this one
+        (0: the first) are skipped whatever `collect` says (a caller that observes only the
+        last of them)."""
         if self._robots is None:
             self.robots()                   # refreshes the caches after a spawn or delete
         parts = self._stepped[0]
         readings = []
         left = steps
+        skipped_until = self.step_count + collect_from   # step count after the last skipped
         self._safe_until = self._single_until = -1     # the guard's answers hold for one call
         changes = self.contacts.changes if until_news else None
         while left > 0:
@@ -178,7 +183,7 @@ class World:
             for robot, part in parts:
                 part.after_step(now)
                 if part.due(now):
-                    if collect is True or part in collect:
+                    if (collect is True or part in collect) and self.step_count > skipped_until:
                         readings.append(Reading(robot, part, part.measure(now)))
                     else:
                         part.skip(now)
@@ -208,10 +213,11 @@ class World:
         True when read."""
         if self.step_count <= self._safe_until:
             return False
-        self.contacts.update(self.client, self.sim_time, self._stepped[1], self._body_owner,
-                             self._grounds)
-        if touched is not None:
-            touched.update(self.contacts.touching())
+        pairs = self.contacts.update(self.client, self.sim_time, self._stepped[1],
+                                     self._body_owner, self._grounds)
+        self._read_at = self.step_count
+        if touched is not None and pairs:
+            touched.update(pairs)
         return True
 
     def _quiet_steps(self, most, now):
@@ -232,9 +238,12 @@ class World:
             k -= 1
         k = self._batcher.largest_exact(self.step_size, k)
         if k > 1 and self.step_count + k > self._safe_until:
-            robots, others, grounds = self._guarded
-            safe = self._batcher.safe_time(robots, others, grounds, most * self.step_size,
-                                           self._statics)
+            if self._read_at == self.step_count and self.contacts.any_touching():
+                safe = 0.0                  # a robot touches a model now: no need to ask
+            else:
+                robots, others, grounds = self._guarded
+                safe = self._batcher.safe_time(robots, others, grounds,
+                                               most * self.step_size, self._statics)
             self._safe_until = self.step_count + int(safe / self.step_size)
             wanted, k = k, self._batcher.largest_exact(
                 self.step_size, min(k, self._safe_until - self.step_count))
