@@ -12,7 +12,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from pybullet_gazebo.engine import batching, registry
 from pybullet_gazebo.engine.diff_drive import DiffDrive
-from pybullet_gazebo.engine.part import Part
+from pybullet_gazebo.engine.part import SCHEDULE_SLACK, Part, next_period_time
 from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
 from pybullet_gazebo.engine.transforms import Pose
 from pybullet_gazebo.engine.world import World
@@ -205,12 +205,19 @@ def test_pressed_on_a_barrier_it_steps_one_by_one_and_reads_contacts_after_each(
         counts["hooks"] += 1
         hook(*args)
     world.contacts.update, drive_part.before_step = read, counted_hook
+    guard = world._batcher.safe_time
+
+    def counted_guard(*args, **kwargs):
+        counts["guard"] = counts.get("guard", 0) + 1
+        return guard(*args, **kwargs)
+    world._batcher.safe_time = counted_guard
     touched = set()
     world.advance(100, touched=touched)
     assert touched and all(other.startswith("jersey_barrier") for _, other in touched)
     assert calls.calls == calls.steps == 100
     assert counts["reads"] == 100
     assert counts["hooks"] < 30                   # the drive's 20 Hz, not every step
+    assert "guard" not in counts                  # touching: the guard is not even asked
 
 
 def test_a_wrench_and_a_reset_in_between_stay_identical(make_world, world02, m2wr_urdf):
@@ -303,3 +310,66 @@ def test_safe_time_shrinks_near_an_obstacle(make_world, world02, m2wr_urdf):
     world.set_model_state("m2wr", Pose.from_xyz_rpy(0, 5.55, 0.1, 0, 0, -math.pi / 2))
     world.advance(40)
     assert world._batcher.safe_time(robots, others, grounds, 0.1) < 2 * STEP
+
+
+def test_a_20_hz_drive_and_laser_cost_four_bullet_calls_per_0_1_s(make_world, world02,
+                                                                 m2wr_urdf):
+    """In the open (row A 2 m to the side) the drive's 20 Hz updates and the laser's 20 Hz
+    scans, one step apart, cut each 20 steps into 9 + 1 + 9 + 1 and nothing more: the drive's
+    schedule, which adds its period to its last time, runs a few 1e-17 s ahead of the steps'
+    times, and that rounding must not cost a Bullet call of its own (it cost two in three
+    of every ten commands)."""
+    world = make_world(world02)
+    robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(-1.0, 7.0, 0.1))
+    drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
+    world.advance(CONTROL)                        # settled, first scan taken
+    calls = Calls(world)
+    for command in [(0.2, 0.0), (0.3, 0.1), (0.2, -0.1)] * 10:
+        drive_part.set_command(*command)
+        world.advance(CONTROL, collect=())
+    assert calls.steps == 30 * CONTROL
+    assert calls.calls == 30 * 4
+
+
+def test_a_schedule_a_rounding_ahead_is_not_a_reset():
+    """next_period_time: `last` above `now` by a rounding still promises the next period;
+    by more (the sim time went back: a reset) it promises nothing."""
+    period = 0.05
+    last = 0.0
+    for _ in range(3):
+        last += period                            # 0.15000000000000002
+    now = 30 * 0.005                              # 0.15
+    assert now < last < now + SCHEDULE_SLACK
+    assert next_period_time(last, period, now) == last + period - SCHEDULE_SLACK
+    assert next_period_time(now + 0.01, period, now) == now
+    assert next_period_time(None, period, now) == now
+    assert next_period_time(now - 0.01, period, now) == now - 0.01 + period - SCHEDULE_SLACK
+
+
+def test_collect_from_skips_the_readings_before_it_as_single_steps_do(make_world, world02,
+                                                                      m2wr_urdf):
+    """advance(n, collect, collect_from=i): the readings due in the first i steps are skipped
+    (schedules and noise go on), those from step i on are measured; the same scans, to the
+    last bit of their noise, as stepping one by one and collecting from step i."""
+    from pybullet_gazebo.engine.ray_sensor import RaySensor
+    runs = []
+    for batched in (False, True):
+        world = make_world(world02)
+        robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(-1.0, 7.0, 0.1))
+        laser = robot.parts_with(RaySensor.KEY)[0]
+        drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
+        out = []
+        for index, first in enumerate([5, 10, 0, 11, 20] * 3):
+            drive_part.set_command(0.3, 0.4 if index % 2 else -0.4)
+            if batched:
+                readings = world.advance(CONTROL, collect=(laser,), collect_from=first)
+            else:
+                readings = []
+                for step in range(CONTROL):
+                    readings += world.step(collect=(laser,) if step >= first else ())
+            out.append(readings_record(readings))
+        runs.append((out, state(world, robot)))
+    assert runs[0] == runs[1]
+    counts = [len(record) for record in runs[1][0][:5]]
+    # 20 Hz scans at the 1st and 11th step of each 20 (the first came with the spawn's step)
+    assert counts == [1, 1, 2, 0, 0]

@@ -60,8 +60,13 @@ SCHEDULE_SLACK = 2e-9      # [s] next_activity_time's margin under a schedule's 
 
 def next_period_time(last, period, now):
     """next_activity_time of a schedule due once `period` [s] passed since `last` (None:
-    due at once; period 0: every step), with the margin that keeps it on the safe side."""
-    if last is None or period <= 0.0 or now < last:
+    due at once; period 0: every step), with the margin that keeps it on the safe side.
+    A schedule is also due whenever the sim time is below `last` (time went back): a `last`
+    above `now` by less than SCHEDULE_SLACK is rounding, not that (a schedule that adds its
+    period to `last`, as the diff drive's does, runs a few 1e-17 s ahead of the steps'
+    times), and the next step's time (more than SCHEDULE_SLACK after now) is past it;
+    answering `now` there cost a Bullet call of its own at every such update."""
+    if last is None or period <= 0.0 or now < last - SCHEDULE_SLACK:
         return now
     return last + period - SCHEDULE_SLACK
 
