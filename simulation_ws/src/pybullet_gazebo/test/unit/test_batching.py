@@ -373,3 +373,34 @@ def test_collect_from_skips_the_readings_before_it_as_single_steps_do(make_world
     counts = [len(record) for record in runs[1][0][:5]]
     # 20 Hz scans at the 1st and 11th step of each 20 (the first came with the spawn's step)
     assert counts == [1, 1, 2, 0, 0]
+
+
+def test_touching_at_the_end_of_a_call_then_moved_away_batches_again(make_world, world02,
+                                                                     m2wr_urdf):
+    """The guard is not asked while a robot touches a model at the step (contacts read at
+    that very step). A call ending on a barrier, a teleport to the open in between: the
+    next calls batch again, and the run is bit for bit single stepping's, events included."""
+    runs = {}
+    for batched in (False, True):
+        world = make_world(world02)
+        robot = world.spawn_urdf("m2wr", m2wr_urdf,
+                                 Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2))
+        calls = Calls(world)
+        marks = {}
+
+        def between(index, world=world, calls=calls, marks=marks):
+            if index == 30:
+                assert world.touching()           # pressed on row A's face
+                marks["pressed"] = calls.calls
+                world.set_model_state("m2wr", Pose.from_xyz_rpy(-1.0, 7.0, 0.1))
+            if index == 32:
+                marks["open"] = calls.calls
+        trace = drive(world, robot, [(0.5, 0.0)] * 30 + [(0.3, 0.2)] * 10, batched, between)
+        runs[batched] = trace, calls, marks
+    (single, single_events), _, _ = runs[False]
+    (trace, events), calls, marks = runs[True]
+    assert events and events == single_events
+    assert trace == single
+    assert not any(touched for _, _, touched in trace[30:])
+    assert marks["pressed"] > 20 * 5              # the last commands on the barrier: singles
+    assert calls.calls - marks["open"] == 8 * 4   # in the open: 9 + 1 + 9 + 1 per command
