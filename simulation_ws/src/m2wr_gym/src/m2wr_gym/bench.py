@@ -5,13 +5,20 @@
    the same world and m2wr built by the same World, driven by a constant command, stepped with
    client.stepSimulation() alone (no laser, no drive updates, no contacts). Both as sim
    seconds per wall second; the ratio is the environment's share of Bullet's speed.
-2. Two environments in subprocesses (gymnasium's AsyncVectorEnv) against one, in env steps
-   per second of wall time; and, as the machine's own ceiling for that ratio, two bare
-   Bullet steppers in two processes at once against one.
+2. Vectorised (--part vector): the same two episodes (seeds s and s + 1, random free starts,
+   actions drawn ahead, so no sampler runs in the timed loops) stepped in this process one
+   after the other, in one subprocess (an AsyncVectorEnv of one), in two subprocesses at
+   once (AsyncVectorEnv of two), and through stable-baselines3's SubprocVecEnv when it is
+   installed; env steps per second of wall time, each ratio taken within the round. The
+   machine's own ceiling for two processes is measured in the same round: two bare Bullet
+   steppers in two processes at once against one. Also the CPU each side spends (workers
+   per env step, the learner's process per vector step, from /proc) and how busy the two
+   cores were: what separates the figure from the ceiling.
 3. Where one in-process control step's CPU time goes (see breakdown()): Bullet's physics,
    the engine's work around it, the one scan observed, the environment's own Python.
-Measurements alternate in rounds (--rounds) and the best round of each is kept, so a busy
-moment of a shared machine hits both sides alike. The in-process figures are also given per
+Measurements alternate in rounds (--rounds); for 1 and 3 the best round of each is kept, so a
+busy moment of a shared machine hits both sides alike; for 2 the median of the same-round
+ratios (with their range). The in-process figures are also given per
 second of this process's CPU time, which other programs on a shared machine disturb less
 than wall time (but still: note the load, `uptime`, with any figure).
 """
@@ -23,7 +30,9 @@ import gymnasium
 import numpy as np
 from gymnasium.vector import AsyncVectorEnv
 
-from pybullet_gazebo.engine.transforms import Pose
+from m2wr_tools.processes import cpu_seconds
+
+from . import actions
 
 KWARGS = dict(world="world02", start="random", observation="scan", action="continuous",
               control_rate=10.0, max_episode_seconds=120.0, end_on_contact=False)
@@ -128,44 +137,222 @@ def breakdown(steps, seed=0):
             "scan": scan * 1e6, "env": (whole - physics - engine - scan) * 1e6}
 
 
-def vector_env(n, steps):
-    vector = AsyncVectorEnv([make] * n)
+WARMUP = 10          # env steps after each reset before timing (pages touched, caches filled)
+
+
+def stretches(seed, steps):
+    """The vector measurement's work: two episodes (seeds `seed`, `seed` + 1, random free
+    starts), each WARMUP + `steps` continuous actions drawn ahead from its own seed, so that
+    every way of running them steps the same episodes with the same actions (and no
+    sampler runs inside the timed loops)."""
+    space = actions.space(KWARGS["action"])
+    work = []
+    for k in range(2):
+        space.seed(seed + k)
+        work.append((seed + k, np.array([space.sample() for _ in range(WARMUP + steps)])))
+    return work
+
+
+def in_process(work):
+    """The stretches one after the other in this process: env steps/s of wall time and CPU
+    seconds per env step (timed steps only)."""
+    env = make()
+    wall = cpu = 0.0
+    steps = 0
+    for seed, actions in work:
+        _step_all(env, seed, actions[:WARMUP])
+        started, cpu_started = time.perf_counter(), time.process_time()
+        _step_all(env, None, actions[WARMUP:])
+        wall += time.perf_counter() - started
+        cpu += time.process_time() - cpu_started
+        steps += len(actions) - WARMUP
+    env.close()
+    return {"rate": steps / wall, "cpu": cpu / steps}
+
+
+def _step_all(env, seed, actions):
+    """Steps `actions` (after a reset with `seed` unless None), resetting at an episode's end
+    in place of the next action, as AsyncVectorEnv's autoreset does."""
+    if seed is not None:
+        env.reset(seed=seed)
+    ended = False
+    for action in actions:
+        if ended:
+            env.reset()
+            ended = False
+            continue
+        _, _, terminated, truncated, _ = env.step(action)
+        ended = terminated or truncated
+
+
+def in_subprocesses(work, parallel, library="gymnasium"):
+    """The stretches in subprocesses, as a learner runs them: `parallel` = 1 (one
+    AsyncVectorEnv of one env, stretch after stretch) or 2 (both at once, one env per
+    worker); library "sb3": stable-baselines3's SubprocVecEnv instead (its default start
+    method). Returns env steps/s of wall time, CPU seconds per env step in the workers, CPU
+    seconds per vector step in this (the learner's) process, timed steps only."""
+    if library == "sb3":
+        from stable_baselines3.common.vec_env import SubprocVecEnv
+        vector = SubprocVecEnv([make] * parallel)
+        pids = [process.pid for process in vector.processes]
+    else:
+        vector = AsyncVectorEnv([make] * parallel)
+        pids = [process.pid for process in vector.processes]
+    groups = [work] if parallel == 2 else [[one] for one in work]
+    wall = cpu = workers = 0.0
+    steps = vector_steps = 0
     try:
-        vector.action_space.seed(0)
-        vector.reset(seed=list(range(n)))
-        vector.step(vector.action_space.sample())        # workers warm
-        started = time.perf_counter()
-        for _ in range(steps):
-            vector.step(vector.action_space.sample())    # autoreset inside
-        wall = time.perf_counter() - started
+        for group in groups:
+            seeds = [seed for seed, _ in group]
+            actions = np.stack([acts for _, acts in group], axis=1)    # (steps, envs, 2)
+            if library == "sb3":
+                vector.seed(seeds[0])                 # SB3 seeds env i with seed + i
+                vector.reset()
+            else:
+                vector.reset(seed=seeds)
+            for action in actions[:WARMUP]:
+                vector.step(action)
+            workers_started = sum(cpu_seconds(pid) for pid in pids)
+            started, cpu_started = time.perf_counter(), time.process_time()
+            for action in actions[WARMUP:]:
+                vector.step(action)
+            wall += time.perf_counter() - started
+            cpu += time.process_time() - cpu_started
+            workers += sum(cpu_seconds(pid) for pid in pids) - workers_started
+            vector_steps += len(actions) - WARMUP
+            steps += (len(actions) - WARMUP) * parallel
     finally:
         vector.close()
-    return n * steps / wall
+    return {"rate": steps / wall, "worker cpu": workers / steps, "main cpu": cpu / vector_steps,
+            "wall": wall / vector_steps}
+
+
+def sb3_available():
+    try:
+        import stable_baselines3  # noqa: F401  (the training extra: scripts/train.sh)
+    except ImportError:
+        return False
+    return True
+
+
+def vector_round(seed, steps, with_sb3):
+    """One round of the vector figures, all measured within a few seconds of each other:
+    the same two stretches in process, in one subprocess, in two at once (and through SB3
+    when installed); then bare Bullet alone and two bare Bullets in two processes at once,
+    the machine's own two-process ceiling at that moment."""
+    work = stretches(seed, steps)
+    figures = {"in process": in_process(work),
+               "1 subprocess": in_subprocesses(work, 1),
+               "2 subprocesses": in_subprocesses(work, 2)}
+    if with_sb3:
+        figures["2 SB3 subprocesses"] = in_subprocesses(work, 2, "sb3")
+    seconds = steps * 0.1
+    figures["bare Bullet"] = bare_bullet(seconds)[0]
+    figures["2 bare Bullets"] = two_bare_bullets(seconds)
+    return figures
+
+
+def print_vector_round(r, rounds, f):
+    one, sub, two = f["in process"]["rate"], f["1 subprocess"]["rate"], f["2 subprocesses"]["rate"]
+    line = ("[bench] vector round %d/%d: env steps/s in process %.0f, 1 subprocess %.0f, "
+            "2 subprocesses %.0f (%.2fx in process, %.2fx 1 subprocess)"
+            % (r + 1, rounds, one, sub, two, two / one, two / sub))
+    if "2 SB3 subprocesses" in f:
+        sb3 = f["2 SB3 subprocesses"]["rate"]
+        line += ", 2 SB3 subprocesses %.0f (%.2fx in process)" % (sb3, sb3 / one)
+    print(line + "; ceiling: 2 bare Bullets %.2fx one" % (f["2 bare Bullets"] / f["bare Bullet"]),
+          flush=True)
+
+
+def print_vector_summary(rounds, steps):
+    """Median over rounds of each same-round ratio, and where a vector step's time goes."""
+    def median(values):
+        return float(np.median(values))
+
+    def spread(values):
+        return "%.2f-%.2f" % (min(values), max(values))
+
+    ratio = {}
+    for key in ("1 subprocess", "2 subprocesses", "2 SB3 subprocesses"):
+        if key in rounds[0]:
+            ratio[key] = [f[key]["rate"] / f["in process"]["rate"] for f in rounds]
+    two_to_one = [f["2 subprocesses"]["rate"] / f["1 subprocess"]["rate"] for f in rounds]
+    ceiling = [f["2 bare Bullets"] / f["bare Bullet"] for f in rounds]
+    print("\nvectorised (median of %d rounds, same-round ratios, range in brackets; 2 episodes "
+          "x %d env steps, the same actions each way):" % (len(rounds), steps))
+    print("  one env in process:                %6.0f env steps/s"
+          % median([f["in process"]["rate"] for f in rounds]))
+    for key, label in (("1 subprocess", "one env in a subprocess:"),
+                       ("2 subprocesses", "two envs in subprocesses:"),
+                       ("2 SB3 subprocesses", "two in SB3 SubprocVecEnv:")):
+        if key in ratio:
+            print("  %-34s %6.0f env steps/s = %.2fx in process (%s)"
+                  % (label, median([f[key]["rate"] for f in rounds]), median(ratio[key]),
+                     spread(ratio[key])))
+    print("  two in subprocesses / one in a subprocess:   %.2fx (%s)"
+          % (median(two_to_one), spread(two_to_one)))
+    print("  the machine's ceiling, two bare Bullets at once / one: %.2fx (%s)"
+          % (median(ceiling), spread(ceiling)))
+    # CPU: what the two cores did per vector step of two envs, against its wall time
+    inproc = median([f["in process"]["cpu"] for f in rounds])
+    w1 = median([f["1 subprocess"]["worker cpu"] for f in rounds])
+    m1 = median([f["1 subprocess"]["main cpu"] for f in rounds])
+    w2 = median([f["2 subprocesses"]["worker cpu"] for f in rounds])
+    m2 = median([f["2 subprocesses"]["main cpu"] for f in rounds])
+    wall2 = median([f["2 subprocesses"]["wall"] for f in rounds])
+    busy = [(2 * f["2 subprocesses"]["worker cpu"] + f["2 subprocesses"]["main cpu"])
+            / (2 * f["2 subprocesses"]["wall"]) for f in rounds]
+    bound = [2 / (f["2 subprocesses"]["worker cpu"] + f["2 subprocesses"]["main cpu"] / 2)
+             / f["in process"]["rate"] for f in rounds]
+    print("  CPU per env step [us]: in process %.0f; in a worker %.0f alone, %.0f two at once "
+          "(%.2fx in process)" % (inproc * 1e6, w1 * 1e6, w2 * 1e6, w2 / inproc))
+    print("  learner's process per vector step [us]: %.0f with one worker, %.0f with two "
+          "(pipes, pickles, info merging)" % (m1 * 1e6, m2 * 1e6))
+    print("  two envs: a vector step takes %.0f us of wall time; the two cores are busy %.0f %% "
+          "of it (%s)" % (wall2 * 1e6, 100 * median(busy), spread(busy)))
+    print("  if both cores never waited, this CPU per step would give %.2fx in process (%s); "
+          "the rest is waiting: for the slower of the two steps, the pipes' wake-ups, the "
+          "learner's serial part" % (median(bound), spread(bound)))
 
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--steps", type=int, default=600, help="env steps per measurement")
+    p.add_argument("--part", choices=("all", "env", "vector"), default="all",
+                   help="env: the in-process figures (1, 3); vector: the subprocess ones (2)")
+    p.add_argument("--no-sb3", action="store_true",
+                   help="leave out SB3's SubprocVecEnv (measured when stable-baselines3 is "
+                        "installed: scripts/train.sh installs it)")
     args = p.parse_args(argv)
-    bare, env_rate, env_steps, one_sub, two_sub = [], [], [], [], []
-    bare_cpu, env_cpu, two_bare, parts_by_round = [], [], [], []
+    with_sb3 = args.part != "env" and not args.no_sb3 and sb3_available()
+    bare, env_rate, env_steps, bare_cpu, env_cpu, parts_by_round = [], [], [], [], [], []
+    vector_rounds = []
     for r in range(args.rounds):
-        rate, cpu_rate = bare_bullet(args.steps * 0.1)
-        bare.append(rate)
-        bare_cpu.append(cpu_rate)
-        rate, per_s, cpu_rate = one_env(args.steps, seed=r)
-        env_rate.append(rate)
-        env_steps.append(per_s)
-        env_cpu.append(cpu_rate)
-        one_sub.append(vector_env(1, args.steps))
-        two_sub.append(vector_env(2, args.steps))
-        two_bare.append(two_bare_bullets(args.steps * 0.1))
-        parts_by_round.append(breakdown(args.steps // 2, seed=r))
-        print("[bench] round %d/%d: bare Bullet %.0fx real time, env %.0fx (%.0f steps/s), "
-              "1 subprocess %.0f steps/s, 2 subprocesses %.0f steps/s, 2 bare Bullets %.0fx"
-              % (r + 1, args.rounds, bare[-1], env_rate[-1], env_steps[-1], one_sub[-1],
-                 two_sub[-1], two_bare[-1]), flush=True)
+        if args.part != "vector":
+            rate, cpu_rate = bare_bullet(args.steps * 0.1)
+            bare.append(rate)
+            bare_cpu.append(cpu_rate)
+            rate, per_s, cpu_rate = one_env(args.steps, seed=r)
+            env_rate.append(rate)
+            env_steps.append(per_s)
+            env_cpu.append(cpu_rate)
+            parts_by_round.append(breakdown(args.steps // 2, seed=r))
+            print("[bench] round %d/%d: bare Bullet %.0fx real time, env %.0fx (%.0f steps/s)"
+                  % (r + 1, args.rounds, bare[-1], env_rate[-1], env_steps[-1]), flush=True)
+        if args.part != "env":
+            vector_rounds.append(vector_round(2 * r, args.steps, with_sb3))
+            print_vector_round(r, args.rounds, vector_rounds[-1])
+    if args.part != "vector":
+        print_env_summary(args, bare, env_rate, env_steps, bare_cpu, env_cpu, parts_by_round)
+    if args.part != "env":
+        if not with_sb3 and not args.no_sb3:
+            print("\n(SB3's SubprocVecEnv left out: stable-baselines3 is not installed)")
+        print_vector_summary(vector_rounds, args.steps)
+    return 0
+
+
+def print_env_summary(args, bare, env_rate, env_steps, bare_cpu, env_cpu, parts_by_round):
     print("\nbest of %d rounds, %d env steps each (world02, 10 Hz, 720 beams, random actions):"
           % (args.rounds, args.steps))
     print("  bare Bullet stepping (same world + m2wr):  %6.0f sim s / wall s" % max(bare))
@@ -174,19 +361,12 @@ def main(argv=None):
     print("  environment / bare Bullet:               %6.2f" % (max(env_rate) / max(bare)))
     print("  per CPU second: bare Bullet %.0f, environment %.0f sim s; ratio %.2f"
           % (max(bare_cpu), max(env_cpu), max(env_cpu) / max(bare_cpu)))
-    print("  one environment in a subprocess:         %6.0f env steps/s" % max(one_sub))
-    print("  two environments in subprocesses:        %6.0f env steps/s  (%.2fx one in a "
-          "subprocess, %.2fx one in process)" % (max(two_sub), max(two_sub) / max(one_sub),
-                                                 max(two_sub) / max(env_steps)))
     parts = min(parts_by_round, key=lambda parts: parts["env step"])
     print("  CPU per env step in process [us] (round with the least): %.0f = Bullet's physics "
           "%.0f + engine around it %.0f + one scan %.0f + environment %.0f; "
           "env / bare Bullet from these: %.2f"
           % (parts["env step"], parts["physics"], parts["engine"], parts["scan"], parts["env"],
              parts["physics"] / parts["env step"]))
-    print("  the machine's ceiling: two bare Bullet processes at once %.2fx one"
-          % (max(two_bare) / max(bare)))
-    return 0
 
 
 if __name__ == "__main__":
