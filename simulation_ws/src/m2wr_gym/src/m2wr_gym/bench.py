@@ -23,8 +23,11 @@ second of this process's CPU time, which other programs on a shared machine dist
 than wall time (but still: note the load, `uptime`, with any figure).
 """
 import argparse
+import contextlib
 import multiprocessing
+import signal
 import time
+import warnings
 
 import gymnasium
 import numpy as np
@@ -65,6 +68,18 @@ def _bare_bullet_worker(seconds, start, results):
     results.put(bare_bullet(seconds, start)[0])
 
 
+@contextlib.contextmanager
+def children_ignore_ctrl_c():
+    """Processes started inside have SIGINT blocked for good (they inherit the signal mask),
+    so a Ctrl-C reaches this process alone, which then closes them and no worker prints a
+    traceback; a Ctrl-C pressed meanwhile is delivered here as the block ends."""
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
 def two_bare_bullets(seconds):
     """The machine's own ceiling for two processes: summed sim s / wall s of two bare Bullet
     steppers running at once (each as bare_bullet), in two processes."""
@@ -72,15 +87,22 @@ def two_bare_bullets(seconds):
     start, results = context.Barrier(2), context.Queue()
     workers = [context.Process(target=_bare_bullet_worker, args=(seconds, start, results))
                for _ in range(2)]
-    for worker in workers:
-        worker.start()
+    finished = False
     try:
-        return sum(results.get(timeout=600) for _ in workers)
+        with children_ignore_ctrl_c():
+            for worker in workers:
+                worker.start()
+        total = sum(results.get(timeout=600) for _ in workers)
+        finished = True
+        return total
     finally:
         for worker in workers:
-            worker.join(timeout=10)
+            if worker.pid is None:
+                continue                         # not started
+            worker.join(timeout=10 if finished else 0)
             if worker.is_alive():
                 worker.terminate()
+                worker.join()
 
 
 def one_env(steps, seed=0):
@@ -191,17 +213,18 @@ def in_subprocesses(work, parallel, library="gymnasium"):
     worker); library "sb3": stable-baselines3's SubprocVecEnv instead (its default start
     method). Returns env steps/s of wall time, CPU seconds per env step in the workers, CPU
     seconds per vector step in this (the learner's) process, timed steps only."""
-    if library == "sb3":
-        from stable_baselines3.common.vec_env import SubprocVecEnv
-        vector = SubprocVecEnv([make] * parallel)
-        pids = [process.pid for process in vector.processes]
-    else:
-        vector = AsyncVectorEnv([make] * parallel)
-        pids = [process.pid for process in vector.processes]
     groups = [work] if parallel == 2 else [[one] for one in work]
     wall = cpu = workers = 0.0
     steps = vector_steps = 0
+    vector, finished = None, False
     try:
+        with children_ignore_ctrl_c():
+            if library == "sb3":
+                from stable_baselines3.common.vec_env import SubprocVecEnv
+                vector = SubprocVecEnv([make] * parallel)
+            else:
+                vector = AsyncVectorEnv([make] * parallel)
+        pids = [process.pid for process in vector.processes]
         for group in groups:
             seeds = [seed for seed, _ in group]
             actions = np.stack([acts for _, acts in group], axis=1)    # (steps, envs, 2)
@@ -221,10 +244,32 @@ def in_subprocesses(work, parallel, library="gymnasium"):
             workers += sum(cpu_seconds(pid) for pid in pids) - workers_started
             vector_steps += len(actions) - WARMUP
             steps += (len(actions) - WARMUP) * parallel
+        finished = True
     finally:
-        vector.close()
+        if vector is not None:
+            _close(vector, finished)
     return {"rate": steps / wall, "worker cpu": workers / steps, "main cpu": cpu / vector_steps,
             "wall": wall / vector_steps}
+
+
+def _close(vector, finished):
+    """Closes a vector env; after a Ctrl-C amid a step its workers are ended at once (a
+    polite close would warn, or wait for a reply that may have been read already)."""
+    if finished:
+        vector.close()
+        return
+    for process in vector.processes:
+        if process.is_alive():
+            process.terminate()
+        process.join()
+    if isinstance(vector, AsyncVectorEnv):          # its pipes and shared memory
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                vector.close(terminate=True)
+            except (EOFError, OSError):
+                pass
+    vector.closed = True
 
 
 def sb3_available():
@@ -308,11 +353,12 @@ def print_vector_summary(rounds, steps):
           "(%.2fx in process)" % (inproc * 1e6, w1 * 1e6, w2 * 1e6, w2 / inproc))
     print("  learner's process per vector step [us]: %.0f with one worker, %.0f with two "
           "(pipes, pickles, info merging)" % (m1 * 1e6, m2 * 1e6))
-    print("  two envs: a vector step takes %.0f us of wall time; the two cores are busy %.0f %% "
-          "of it (%s)" % (wall2 * 1e6, 100 * median(busy), spread(busy)))
-    print("  if both cores never waited, this CPU per step would give %.2fx in process (%s); "
-          "the rest is waiting: for the slower of the two steps, the pipes' wake-ups, the "
-          "learner's serial part" % (median(bound), spread(bound)))
+    print("  two envs: a vector step takes %.0f us of wall time; the learner and its workers "
+          "used %.0f %% of the two cores' time (%s; other programs may use the rest)"
+          % (wall2 * 1e6, 100 * median(busy), spread(busy)))
+    print("  if the two cores did nothing but this work, with no waiting, this CPU per step "
+          "would give %.2fx in process (%s); the rest is waiting: for the slower of the two "
+          "steps, the pipes' wake-ups, the learner's serial part" % (median(bound), spread(bound)))
 
 
 def main(argv=None):
