@@ -13,7 +13,7 @@
    machine's own ceiling for two processes is measured in the same round: two bare Bullet
    steppers in two processes at once against one. Also the CPU each side spends (workers
    per env step, the learner's process per vector step, from /proc) and how busy the two
-   cores were: what separates the figure from the ceiling.
+   cores were: what separates the figure from the ceiling. Odd rounds run in reverse order.
 3. Where one in-process control step's CPU time goes (see breakdown()): Bullet's physics,
    the engine's work around it, the one scan observed, the environment's own Python.
 Measurements alternate in rounds (--rounds); for 1 and 3 the best round of each is kept, so a
@@ -280,21 +280,22 @@ def sb3_available():
     return True
 
 
-def vector_round(seed, steps, with_sb3):
-    """One round of the vector figures, all measured within a few seconds of each other:
-    the same two stretches in process, in one subprocess, in two at once (and through SB3
-    when installed); then bare Bullet alone and two bare Bullets in two processes at once,
-    the machine's own two-process ceiling at that moment."""
-    work = stretches(seed, steps)
-    figures = {"in process": in_process(work),
-               "1 subprocess": in_subprocesses(work, 1),
-               "2 subprocesses": in_subprocesses(work, 2)}
-    if with_sb3:
-        figures["2 SB3 subprocesses"] = in_subprocesses(work, 2, "sb3")
+def vector_round(r, steps, with_sb3):
+    """Round r of the vector figures, all measured within a few seconds of each other: the
+    same two stretches in process, in one subprocess, in two at once (and through SB3 when
+    installed); bare Bullet alone and two bare Bullets in two processes at once, the
+    machine's own two-process ceiling at that moment. Odd rounds go in reverse order, so a
+    machine growing busier or quieter within rounds favours no side."""
+    work = stretches(2 * r, steps)
     seconds = steps * 0.1
-    figures["bare Bullet"] = bare_bullet(seconds)[0]
-    figures["2 bare Bullets"] = two_bare_bullets(seconds)
-    return figures
+    runs = [("in process", lambda: in_process(work)),
+            ("1 subprocess", lambda: in_subprocesses(work, 1)),
+            ("2 subprocesses", lambda: in_subprocesses(work, 2))]
+    if with_sb3:
+        runs.append(("2 SB3 subprocesses", lambda: in_subprocesses(work, 2, "sb3")))
+    runs += [("bare Bullet", lambda: bare_bullet(seconds)[0]),
+             ("2 bare Bullets", lambda: two_bare_bullets(seconds))]
+    return {name: run() for name, run in (runs[::-1] if r % 2 else runs)}
 
 
 def print_vector_round(r, rounds, f):
@@ -347,8 +348,11 @@ def print_vector_summary(rounds, steps):
     wall2 = median([f["2 subprocesses"]["wall"] for f in rounds])
     busy = [(2 * f["2 subprocesses"]["worker cpu"] + f["2 subprocesses"]["main cpu"])
             / (2 * f["2 subprocesses"]["wall"]) for f in rounds]
-    bound = [2 / (f["2 subprocesses"]["worker cpu"] + f["2 subprocesses"]["main cpu"] / 2)
-             / f["in process"]["rate"] for f in rounds]
+    # two cores doing nothing but this work, never waiting: env steps per CPU second of the
+    # pair (workers + the learner's share) x 2 cores, against one env in process
+    bound = [2 * f["in process"]["cpu"]
+             / (f["2 subprocesses"]["worker cpu"] + f["2 subprocesses"]["main cpu"] / 2)
+             for f in rounds]
     print("  CPU per env step [us]: in process %.0f; in a worker %.0f alone, %.0f two at once "
           "(%.2fx in process)" % (inproc * 1e6, w1 * 1e6, w2 * 1e6, w2 / inproc))
     print("  learner's process per vector step [us]: %.0f with one worker, %.0f with two "
@@ -387,7 +391,7 @@ def main(argv=None):
             print("[bench] round %d/%d: bare Bullet %.0fx real time, env %.0fx (%.0f steps/s)"
                   % (r + 1, args.rounds, bare[-1], env_rate[-1], env_steps[-1]), flush=True)
         if args.part != "env":
-            vector_rounds.append(vector_round(2 * r, args.steps, with_sb3))
+            vector_rounds.append(vector_round(r, args.steps, with_sb3))
             print_vector_round(r, args.rounds, vector_rounds[-1])
     if args.part != "vector":
         print_env_summary(args, bare, env_rate, env_steps, bare_cpu, env_cpu, parts_by_round)
