@@ -177,34 +177,28 @@ def stretches(seed, steps):
 
 def in_process(work):
     """The stretches one after the other in this process: env steps/s of wall time and CPU
-    seconds per env step (timed steps only)."""
+    seconds per env step (timed steps only). An episode's end is followed by a reset in
+    place of the next action, as AsyncVectorEnv's autoreset does."""
     env = make()
     wall = cpu = 0.0
-    steps = 0
-    for seed, actions in work:
-        _step_all(env, seed, actions[:WARMUP])
-        started, cpu_started = time.perf_counter(), time.process_time()
-        _step_all(env, None, actions[WARMUP:])
+    timed = 0
+    for seed, chosen in work:
+        env.reset(seed=seed)
+        ended = False
+        for i, action in enumerate(chosen):
+            if i == WARMUP:
+                started, cpu_started = time.perf_counter(), time.process_time()
+            if ended:
+                env.reset()
+                ended = False
+                continue
+            _, _, terminated, truncated, _ = env.step(action)
+            ended = terminated or truncated
         wall += time.perf_counter() - started
         cpu += time.process_time() - cpu_started
-        steps += len(actions) - WARMUP
+        timed += len(chosen) - WARMUP
     env.close()
-    return {"rate": steps / wall, "cpu": cpu / steps}
-
-
-def _step_all(env, seed, actions):
-    """Steps `actions` (after a reset with `seed` unless None), resetting at an episode's end
-    in place of the next action, as AsyncVectorEnv's autoreset does."""
-    if seed is not None:
-        env.reset(seed=seed)
-    ended = False
-    for action in actions:
-        if ended:
-            env.reset()
-            ended = False
-            continue
-        _, _, terminated, truncated, _ = env.step(action)
-        ended = terminated or truncated
+    return {"rate": timed / wall, "cpu": cpu / timed}
 
 
 def in_subprocesses(work, parallel, library="gymnasium"):
@@ -227,23 +221,23 @@ def in_subprocesses(work, parallel, library="gymnasium"):
         pids = [process.pid for process in vector.processes]
         for group in groups:
             seeds = [seed for seed, _ in group]
-            actions = np.stack([acts for _, acts in group], axis=1)    # (steps, envs, 2)
+            batches = np.stack([chosen for _, chosen in group], axis=1)  # (steps, envs, 2)
             if library == "sb3":
                 vector.seed(seeds[0])                 # SB3 seeds env i with seed + i
                 vector.reset()
             else:
                 vector.reset(seed=seeds)
-            for action in actions[:WARMUP]:
-                vector.step(action)
+            for batch in batches[:WARMUP]:
+                vector.step(batch)
             workers_started = sum(cpu_seconds(pid) for pid in pids)
             started, cpu_started = time.perf_counter(), time.process_time()
-            for action in actions[WARMUP:]:
-                vector.step(action)
+            for batch in batches[WARMUP:]:
+                vector.step(batch)
             wall += time.perf_counter() - started
             cpu += time.process_time() - cpu_started
             workers += sum(cpu_seconds(pid) for pid in pids) - workers_started
-            vector_steps += len(actions) - WARMUP
-            steps += (len(actions) - WARMUP) * parallel
+            vector_steps += len(batches) - WARMUP
+            steps += (len(batches) - WARMUP) * parallel
         finished = True
     finally:
         if vector is not None:
