@@ -412,6 +412,22 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
 
 
 @njit(**_JIT)
+def rotation_matrices(quaternions, out):
+    """out (n, 3, 3) = the rotation matrices of quaternions (n, 4), unit, (x, y, z, w)."""
+    for k in range(quaternions.shape[0]):
+        x, y, z, w = quaternions[k, 0], quaternions[k, 1], quaternions[k, 2], quaternions[k, 3]
+        out[k, 0, 0] = 1.0 - 2.0 * (y * y + z * z)
+        out[k, 0, 1] = 2.0 * (x * y - z * w)
+        out[k, 0, 2] = 2.0 * (x * z + y * w)
+        out[k, 1, 0] = 2.0 * (x * y + z * w)
+        out[k, 1, 1] = 1.0 - 2.0 * (x * x + z * z)
+        out[k, 1, 2] = 2.0 * (y * z - x * w)
+        out[k, 2, 0] = 2.0 * (x * z - y * w)
+        out[k, 2, 1] = 2.0 * (y * z + x * w)
+        out[k, 2, 2] = 1.0 - 2.0 * (x * x + y * y)
+
+
+@njit(**_JIT)
 def _rotated(q, vx, vy, vz):
     """(vx, vy, vz) rotated by the unit quaternion q (x, y, z, w): v + 2 w (u x v) +
     2 u x (u x v), u the vector part (transforms.rotate's arithmetic)."""
@@ -515,6 +531,9 @@ def warm_up():
                     np.array([0.0, 0.0, 0.0, 1.0]), np.array([[1.0, 0.0], [0.0, 1.0]]), 0.0,
                     math.pi / 2, frame, fan, directions)
     assert directions[1, 1] == 1.0 and frame[3, 2] == 1.0, (directions, frame)
+    matrix = np.empty((1, 3, 3))
+    rotation_matrices(np.array([[0.0, 0.0, 1.0, 0.0]]), matrix)      # half a turn about z
+    assert matrix[0, 0, 0] == -1.0 and matrix[0, 2, 2] == 1.0, matrix
     out = np.empty(2, dtype=np.float32)
     noisy_ranges(np.array([1.0, np.inf]), np.array([0.5, 0.5]), 0.0, 0.1, 0.1, 10.0, out)
     assert out[0] == np.float32(1.05) and out[1] == np.inf, out
