@@ -231,12 +231,13 @@ def _index_windows(fan, n, low, high, windows):
 
 
 @njit(**_JIT)
-def _nearest_first(origin, kind, position, rotation, size, bound):
-    """(order, start): shape indices by how near the origin any of their points can be,
-    nearest first, and that distance [m] for each shape (a box's own distance from the
-    origin, 0 inside; else where its bounding sphere starts)."""
-    start = np.empty(position.shape[0])
-    for j in range(position.shape[0]):
+def _nearest_first(origin, candidates, kind, position, rotation, size, bound):
+    """(order, start): the shape indices `candidates` by how near the origin any of their
+    points can be, nearest first, and that distance [m] for each shape (a box's own distance
+    from the origin, 0 inside; else where its bounding sphere starts; inf for the shapes
+    that are not candidates)."""
+    start = np.full(position.shape[0], math.inf)
+    for j in candidates:
         rx = position[j, 0] - origin[0]
         ry = position[j, 1] - origin[1]
         rz = position[j, 2] - origin[2]
@@ -251,7 +252,33 @@ def _nearest_first(origin, kind, position, rotation, size, bound):
             start[j] = math.sqrt(gap)
         else:
             start[j] = math.sqrt(rx * rx + ry * ry + rz * rz) - bound[j]
-    return np.argsort(start), start
+    return candidates[np.argsort(start[candidates])], start
+
+
+@njit(**_JIT)
+def _crossing_plane(origin, plane_normal, kind, position, rotation, size, bound, body,
+                    exclude_body, range_min, range_max):
+    """The indices of the shapes nearest_hits tries (in index order): those of bodies other
+    than exclude_body that reach into [range_min, range_max] of the origin and cross the
+    plane through it with unit normal plane_normal (nearest_hits' own first tests)."""
+    keep = np.empty(position.shape[0], dtype=np.int64)
+    count = 0
+    for j in range(position.shape[0]):
+        if body[j] == exclude_body:
+            continue
+        rx = position[j, 0] - origin[0]
+        ry = position[j, 1] - origin[1]
+        rz = position[j, 2] - origin[2]
+        distance = math.sqrt(rx * rx + ry * ry + rz * rz)
+        if distance - bound[j] > range_max or distance + bound[j] < range_min:
+            continue
+        if abs(rx * plane_normal[0] + ry * plane_normal[1] + rz * plane_normal[2]) \
+                > _support(kind[j], rotation[j], size[j], plane_normal[0], plane_normal[1],
+                           plane_normal[2]):
+            continue
+        keep[count] = j
+        count += 1
+    return keep[:count]
 
 
 @njit(**_JIT)
@@ -293,7 +320,12 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
     if culled:
-        order, nearest = _nearest_first(origin, kind, position, rotation, size, bound)
+        # only the shapes that pass the tests below are sorted (they pass them again: the
+        # same arithmetic), as which rays a shape is tried on does not change any distance
+        order, nearest = _nearest_first(
+            origin, _crossing_plane(origin, plane_normal, kind, position, rotation, size,
+                                    bound, body, exclude_body, range_min, range_max),
+            kind, position, rotation, size, bound)
     else:
         order, nearest = np.arange(kind.shape[0]), np.zeros(0)
     for j in order:
@@ -370,7 +402,8 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
     if culled:
-        order, nearest = _nearest_first(origin, None, position, rotation, bound, bound)
+        order, nearest = _nearest_first(origin, np.arange(position.shape[0]), None,
+                                        position, rotation, bound, bound)
     else:
         order, nearest = np.arange(position.shape[0]), np.zeros(0)
     for j in order:

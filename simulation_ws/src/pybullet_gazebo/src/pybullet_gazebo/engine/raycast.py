@@ -248,14 +248,32 @@ class _Scene:
         self._poses = [None] * len(self._bodies)
         self._planes = [[] for _ in self._bodies]
         self.planes = list(self._static_planes)
+        # (index, body id) of the bodies with a base and no links, whose pose is one call's
+        # answer (most are: barrels, cans); the others read through _Body.read_pose
+        self._base_only = [(index, body.body_id) for index, body in enumerate(self._bodies)
+                           if body.links == [-1]]
+        self._linked = [index for index, body in enumerate(self._bodies)
+                        if body.links != [-1]]
 
     def update(self, base_pose, link_states):
         """Re-places the dynamic bodies that moved since the last update (all at the first)."""
+        poses, moved = self._poses, []
+        for index, body_id in self._base_only:
+            pose = (base_pose(body_id),)
+            if pose != poses[index]:
+                moved.append((index, pose))
+        for index in self._linked:
+            pose = self._bodies[index].read_pose(base_pose, link_states)
+            if pose != poses[index]:
+                moved.append((index, pose))
+        if moved:
+            self._place(moved)
+
+    def _place(self, moved):
+        """Writes the rows of the bodies moved, [(index, pose)]."""
         planes_moved = False
-        for index, body in enumerate(self._bodies):
-            pose = body.read_pose(base_pose, link_states)
-            if pose == self._poses[index]:
-                continue
+        for index, pose in moved:
+            body = self._bodies[index]
             shape_rows, mesh_rows = self._slices[index]
             planes = body.place_into(pose, self.shapes, shape_rows, self.dynamic_meshes,
                                      mesh_rows)
