@@ -87,6 +87,7 @@ class RaySensor(Part):
         self._frame = np.empty((4, 3))       # scratch of measure(): ray_kernel.fan_rays'
         self._fan = np.empty(8)
         self._directions = np.empty((samples, 3))
+        self._rays_pose = None               # the link pose those three were laid out at
         self._noisy = spec.noise_stddev > 0.0 or spec.noise_mean != 0.0
         self._normals = np.empty(samples) if self._noisy else _NO_NOISE   # measure()'s draws
         # the scan's numbers as measure() passes them on (the spec is frozen)
@@ -169,11 +170,16 @@ class RaySensor(Part):
         angle_min, angle_max, range_min, range_max, noise_mean, noise_stddev = self._limits
         position, orientation = self._link_frame()
         frame, fan, directions = self._frame, self._fan, self._directions
-        if not ray_kernel.fan_rays(np.asarray(position, dtype=float),
-                                   np.asarray(orientation, dtype=float), self._offset[0],
-                                   self._offset[1], self._cos_sin, angle_min,
-                                   self.angle_increment, frame, fan, directions):
-            raise ValueError("ray sensor '%s': its link's pose is not finite" % self.spec.name)
+        pose = (tuple(position), tuple(orientation))
+        if pose != self._rays_pose:          # (a link at rest keeps its rays, to the bit)
+            self._rays_pose = None
+            if not ray_kernel.fan_rays(np.asarray(position, dtype=float),
+                                       np.asarray(orientation, dtype=float), self._offset[0],
+                                       self._offset[1], self._cos_sin, angle_min,
+                                       self.angle_increment, frame, fan, directions):
+                raise ValueError("ray sensor '%s': its link's pose is not finite"
+                                 % self.spec.name)
+            self._rays_pose = pose
         ranges = self._caster.cast_fan(frame, directions, fan, range_min, range_max,
                                        exclude_body=self.body_id)
         # one draw per beam whether it hit or not, so the stream does not depend on the scene
