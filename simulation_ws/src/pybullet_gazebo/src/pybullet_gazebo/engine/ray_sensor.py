@@ -171,7 +171,8 @@ class RaySensor(Part):
         position, orientation = self._link_frame()
         frame, fan, directions = self._frame, self._fan, self._directions
         pose = (tuple(position), tuple(orientation))
-        if pose != self._rays_pose:          # (a link at rest keeps its rays, to the bit)
+        same_rays = pose == self._rays_pose   # a link at rest keeps its rays, to the bit
+        if not same_rays:
             self._rays_pose = None
             if not ray_kernel.fan_rays(np.asarray(position, dtype=float),
                                        np.asarray(orientation, dtype=float), self._offset[0],
@@ -181,7 +182,7 @@ class RaySensor(Part):
                                  % self.spec.name)
             self._rays_pose = pose
         ranges = self._caster.cast_fan(frame, directions, fan, range_min, range_max,
-                                       exclude_body=self.body_id)
+                                       exclude_body=self.body_id, same_rays=same_rays)
         # one draw per beam whether it hit or not, so the stream does not depend on the scene
         normals = self.rng.standard_normal(out=self._normals) if self._noisy else _NO_NOISE
         out = np.empty(len(ranges), dtype=np.float32)

@@ -435,23 +435,24 @@ class RayCaster:
                              exclude_body)
 
     def cast_fan(self, frame, directions, fan, range_min, range_max, exclude_body=None,
-                 cull=True):
+                 cull=True, same_rays=False):
         """A laser's fan, as ray_kernel.fan_rays lays it out: frame (4, 3) the sensor's
         origin and x, y, z axes, directions (n, 3) unit vectors in its xy plane, fan (8,)
-        the kernels' fan. Distances as cast() gives them; `cull`: try each shape only on
-        the beams that can reach it (the same distances to the last bit as without).
-        Asked the same (equal arrays and numbers) with no body moved since, the last answer
-        is given again without casting (a robot at rest scanning an unchanged scene)."""
+        the kernels' fan. Distances as cast() gives them (a new array each call); `cull`:
+        try each shape only on the beams that can reach it (the same distances to the last
+        bit as without). `same_rays`: the caller's word that these three arrays are the
+        ones it passed at its last call, unchanged since (a laser at rest); asked again so
+        with the same ranges and no body moved since, the last answer is given again
+        without casting."""
         fan = fan if cull else ray_kernel.NO_FAN
         scene = self._scene(exclude_body)
-        question = (frame.tobytes(), fan.tobytes(), range_min, range_max, exclude_body,
-                    scene, scene.changes)
+        question = (range_min, range_max, exclude_body, cull, scene, scene.changes)
         last = self._last_fan
-        if last is not None and last[0] == question and np.array_equal(last[1], directions):
+        if same_rays and last is not None and last[0] is directions and last[1] == question:
             return last[2].copy()
         ranges = self._nearest(frame[0], directions, frame[3], fan, range_min, range_max,
                                exclude_body, scene)
-        self._last_fan = (question, directions.copy(), ranges.copy())
+        self._last_fan = (directions, question, ranges.copy())
         return ranges
 
     def _nearest(self, origin, directions, normal, fan, range_min, range_max, exclude_body,
