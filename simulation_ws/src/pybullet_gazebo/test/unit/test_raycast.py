@@ -802,3 +802,18 @@ def test_cached_placement_and_answers_match_a_fresh_caster_to_the_last_bit(clien
         assert np.mean(agree[clear]) > 0.99, round_          # (Bullet errs on grazing beams)
     # the scene did change under the fan, or this test would prove nothing
     assert len({r.tobytes() for r in seen}) > 20
+
+
+def test_compiled_rotation_matrices_are_the_plain_float_arithmetic_to_the_bit():
+    """rotation_matrices runs compiled; its numbers must stay those of the plain IEEE
+    operations (no fused multiply-adds, no reordering), or placed shapes and so every
+    range would change in the last bits."""
+    q = np.random.default_rng(5).normal(size=(2000, 4))
+    q /= np.linalg.norm(q, axis=1)[:, None]
+    x, y, z, w = q.T
+    expected = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+                         2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+                         2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+                        axis=1).reshape(-1, 3, 3)
+    np.testing.assert_array_equal(rotation_matrices(q), expected)
+    np.testing.assert_array_equal(rotation_matrices(tuple(q[7])), expected[7:8])
