@@ -231,13 +231,12 @@ def _index_windows(fan, n, low, high, windows):
 
 
 @njit(**_JIT)
-def _nearest_first(origin, candidates, kind, position, rotation, size, bound):
-    """(order, start): the shape indices `candidates` by how near the origin any of their
-    points can be, nearest first, and that distance [m] for each shape (a box's own distance
-    from the origin, 0 inside; else where its bounding sphere starts; inf for the shapes
-    that are not candidates)."""
-    start = np.full(position.shape[0], math.inf)
-    for j in candidates:
+def _nearest_first(origin, kind, position, rotation, size, bound):
+    """(order, start): shape indices by how near the origin any of their points can be,
+    nearest first, and that distance [m] for each shape (a box's own distance from the
+    origin, 0 inside; else where its bounding sphere starts)."""
+    start = np.empty(position.shape[0])
+    for j in range(position.shape[0]):
         rx = position[j, 0] - origin[0]
         ry = position[j, 1] - origin[1]
         rz = position[j, 2] - origin[2]
@@ -252,33 +251,7 @@ def _nearest_first(origin, candidates, kind, position, rotation, size, bound):
             start[j] = math.sqrt(gap)
         else:
             start[j] = math.sqrt(rx * rx + ry * ry + rz * rz) - bound[j]
-    return candidates[np.argsort(start[candidates])], start
-
-
-@njit(**_JIT)
-def _crossing_plane(origin, plane_normal, kind, position, rotation, size, bound, body,
-                    exclude_body, range_min, range_max):
-    """The indices of the shapes nearest_hits tries (in index order): those of bodies other
-    than exclude_body that reach into [range_min, range_max] of the origin and cross the
-    plane through it with unit normal plane_normal (nearest_hits' own first tests)."""
-    keep = np.empty(position.shape[0], dtype=np.int64)
-    count = 0
-    for j in range(position.shape[0]):
-        if body[j] == exclude_body:
-            continue
-        rx = position[j, 0] - origin[0]
-        ry = position[j, 1] - origin[1]
-        rz = position[j, 2] - origin[2]
-        distance = math.sqrt(rx * rx + ry * ry + rz * rz)
-        if distance - bound[j] > range_max or distance + bound[j] < range_min:
-            continue
-        if abs(rx * plane_normal[0] + ry * plane_normal[1] + rz * plane_normal[2]) \
-                > _support(kind[j], rotation[j], size[j], plane_normal[0], plane_normal[1],
-                           plane_normal[2]):
-            continue
-        keep[count] = j
-        count += 1
-    return keep[:count]
+    return np.argsort(start), start
 
 
 @njit(**_JIT)
@@ -320,12 +293,9 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
     if culled:
-        # only the shapes that pass the tests below are sorted (they pass them again: the
-        # same arithmetic), as which rays a shape is tried on does not change any distance
-        order, nearest = _nearest_first(
-            origin, _crossing_plane(origin, plane_normal, kind, position, rotation, size,
-                                    bound, body, exclude_body, range_min, range_max),
-            kind, position, rotation, size, bound)
+        # (all shapes sorted: which of two hits at 0 m, +0.0 or -0.0, is kept depends on
+        # the order of the shapes that tie there)
+        order, nearest = _nearest_first(origin, kind, position, rotation, size, bound)
     else:
         order, nearest = np.arange(kind.shape[0]), np.zeros(0)
     for j in order:
@@ -359,10 +329,24 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
                 along = rx * dx + ry * dy + rz * dz
                 if _misses_bound(along, distance2, reach, reach2, range_min, range_max):
                     continue
-                near, far = _interval(kind[j], size[j], ox, oy, oz,
-                                      r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz,
-                                      r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz,
-                                      r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz)
+                lx = r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz     # the ray in the shape's
+                ly = r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz     # frame
+                lz = r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz
+                if kind[j] == BOX:
+                    # _interval's slabs one by one: entering a slab beyond the nearest hit so
+                    # far, the ray cannot enter the box nearer (max() keeps an entry that
+                    # large, or gives NaN, which hits nothing); the rest as _interval does
+                    half = size[j]
+                    near_x, far_x = _slab(ox, lx, half[0])
+                    if near_x > out[i]:
+                        continue
+                    near_y, far_y = _slab(oy, ly, half[1])
+                    if near_y > out[i]:
+                        continue
+                    near_z, far_z = _slab(oz, lz, half[2])
+                    near, far = max(near_x, max(near_y, near_z)), min(far_x, min(far_y, far_z))
+                else:
+                    near, far = _interval(kind[j], size[j], ox, oy, oz, lx, ly, lz)
                 if near <= far and range_min <= near <= range_max and near < out[i]:
                     out[i] = near
 
@@ -402,8 +386,7 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
     if culled:
-        order, nearest = _nearest_first(origin, np.arange(position.shape[0]), None,
-                                        position, rotation, bound, bound)
+        order, nearest = _nearest_first(origin, None, position, rotation, bound, bound)
     else:
         order, nearest = np.arange(position.shape[0]), np.zeros(0)
     for j in order:
