@@ -224,3 +224,58 @@ def test_bad_specs_are_refused_by_name(client, scene, changes, message):
     with pytest.raises(ValueError, match=message) as err:
         RaySensor(client, robot, -1, laser_spec(**changes), caster, np.random.default_rng(0))
     assert "head_hokuyo_sensor" in str(err.value)
+
+
+def test_a_sensor_at_rest_sees_a_body_moved_or_pushed_into_its_fan(client, scene):
+    """The robot stands still (its rays and the last scan are reused while nothing moves);
+    a barrel teleported into the beams, then pushed along them, shows in the very next scan
+    where its geometry puts it, the scan goes back to the wall once it is taken away, and
+    the beams follow the robot once it moves."""
+    robot, caster = scene
+    barrel = client.createMultiBody(2.0, client.createCollisionShape(
+        pybullet.GEOM_CYLINDER, radius=0.2, height=0.6), basePosition=(0.0, 5.0, 0.3))
+    caster.add_body(barrel, static=False)
+    sensor = RaySensor(client, robot, -1, laser_spec(noise_stddev=0.0), caster,
+                       np.random.default_rng(0))
+    to_wall = (WALL_X - SENSOR[0]) / math.cos(AHEAD_ANGLE)
+    assert sensor.measure(0.0).ranges[AHEAD] == pytest.approx(to_wall, abs=1e-6)
+    assert sensor.measure(0.05).ranges[AHEAD] == pytest.approx(to_wall, abs=1e-6)
+
+    def barrel_face(x):
+        """Range along beam AHEAD to a barrel of radius 0.2 centred at (x, 0)."""
+        d = np.array([math.cos(AHEAD_ANGLE), math.sin(AHEAD_ANGLE)])
+        c = np.array([x - SENSOR[0], 0.0])
+        along = c @ d
+        return along - math.sqrt(0.2 ** 2 - (c @ c - along ** 2))
+
+    client.resetBasePositionAndOrientation(barrel, (1.0, 0.0, 0.3), (0, 0, 0, 1))
+    assert sensor.measure(0.1).ranges[AHEAD] == pytest.approx(barrel_face(1.0), abs=1e-6)
+    client.resetBaseVelocity(barrel, (1.0, 0.0, 0.0))           # pushed away, no gravity
+    for _ in range(60):
+        client.stepSimulation()                                  # 0.25 s at 240 Hz
+    x = client.getBasePositionAndOrientation(barrel)[0][0]
+    assert 1.2 < x < 1.3
+    assert sensor.measure(0.15).ranges[AHEAD] == pytest.approx(barrel_face(x), abs=1e-6)
+    client.resetBasePositionAndOrientation(barrel, (0.0, 5.0, 0.3), (0, 0, 0, 1))
+    assert sensor.measure(0.2).ranges[AHEAD] == pytest.approx(to_wall, abs=1e-6)
+    # and once the robot itself turns 90 deg left in place, its beams turn with it
+    yaw = Pose.from_xyz_rpy(yaw=math.pi / 2).orientation
+    com = Pose((1.0, 0.0, 0.15), yaw).compose(Pose((0.0, 0.0, 0.1)))
+    client.resetBasePositionAndOrientation(robot, com.position, com.orientation)
+    assert sensor.measure(0.25).ranges[0] == pytest.approx(WALL_X - 1.0, abs=1e-6)
+
+
+def test_a_scan_at_rest_draws_its_noise_anew(client, scene):
+    """Reusing the cast of a robot at rest does not reuse its noise: every scan takes one
+    draw per beam from the generator, as a scan cast anew would."""
+    robot, caster = scene
+    sensor = RaySensor(client, robot, -1, laser_spec(), caster, np.random.default_rng(7))
+    first, second = sensor.measure(0.0).ranges, sensor.measure(0.05).ranges
+    reference = np.random.default_rng(7)
+    expected = analytic_ranges(laser_spec())
+    hit = np.isfinite(expected)
+    for ranges in (first, second):
+        normals = reference.standard_normal(720)
+        np.testing.assert_allclose(ranges[hit], expected[hit] + 0.01 * normals[hit], rtol=0,
+                                   atol=1e-6)
+    assert not np.array_equal(first[hit], second[hit])

@@ -734,3 +734,86 @@ def test_fan_hint_gives_the_same_ranges_on_meshes(client):
         assert hinted.tobytes() == plain.tobytes(), trial
         hits += np.isfinite(plain).sum()
     assert hits > 200 * 720 * 0.05
+
+
+def test_cached_placement_and_answers_match_a_fresh_caster_to_the_last_bit(client):
+    """The caster re-places a dynamic body only when its pose changed and answers a repeated
+    question about the same beams from memory while nothing moved: after every kind of move (teleported, pushed,
+    falling, a linked body's joint turned, at rest) its fan gives exactly what a new caster,
+    with nothing cached, gives for the same beams."""
+    rng = np.random.default_rng(3)
+    client.setGravity(0, 0, -9.8)
+    client.createMultiBody(0.0, client.createCollisionShape(pybullet.GEOM_PLANE))
+    crates = [client.createMultiBody(      # boxes: Bullet's own rays are exact on them
+        2.0, client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=(0.2, 0.3, 0.3)),
+        basePosition=(x, y, 0.3)) for x, y in rng.uniform(-3, 3, size=(6, 2))]
+    box = client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=(0.1, 0.4, 0.3))
+    arm = client.createMultiBody(                          # a base and a link on a hinge
+        1.0, box, basePosition=(2.5, 0.0, 0.3), linkMasses=[1.0],
+        linkCollisionShapeIndices=[box], linkVisualShapeIndices=[-1],
+        linkPositions=[(0.0, 0.8, 0.0)], linkOrientations=[(0, 0, 0, 1)],
+        linkInertialFramePositions=[(0, 0, 0)], linkInertialFrameOrientations=[(0, 0, 0, 1)],
+        linkParentIndices=[0], linkJointTypes=[pybullet.JOINT_REVOLUTE],
+        linkJointAxis=[(0, 0, 1)])
+    walls = [wall(client, 4.0, 4.5), wall(client, -4.5, -4.0)]
+    dynamic = crates + [arm]
+
+    def fresh():
+        caster = RayCaster(client)
+        for body in walls:
+            caster.add_body(body, static=True)
+        for body in dynamic:
+            caster.add_body(body, static=False)
+        return caster
+
+    kept = fresh()
+    angles = -math.pi + 2 * math.pi / 720 * np.arange(720)
+    cos_sin = np.ascontiguousarray(np.stack([np.cos(angles), np.sin(angles)], axis=1))
+    frame, fan, directions = np.empty((4, 3)), np.empty(8), np.empty((720, 3))
+    assert ray_kernel.fan_rays(np.array([0.0, 0.0, 0.3]), np.array([0.0, 0.0, 0.0, 1.0]),
+                               np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]), cos_sin,
+                               angles[0], angles[1] - angles[0], frame, fan, directions)
+    seen = []
+    for round_ in range(40):
+        if round_ % 5 == 1:                                    # teleported
+            body = crates[rng.integers(len(crates))]
+            client.resetBasePositionAndOrientation(
+                body, (*rng.uniform(-3, 3, size=2), 0.3), random_quaternion(rng))
+        elif round_ % 5 == 2:                                  # pushed
+            client.resetBaseVelocity(crates[rng.integers(len(crates))],
+                                     (*rng.uniform(-2, 2, size=2), 0.0))
+        elif round_ % 5 == 3:                                  # a joint turned
+            client.resetJointState(arm, 0, rng.uniform(-1.5, 1.5))
+        if round_ % 5 != 4:                                    # (4: nothing moves)
+            for _ in range(rng.integers(1, 20)):
+                client.stepSimulation()
+        expected = fresh().cast_fan(frame, directions, fan, 0.1, 10.0)
+        for _ in range(2):                                     # cast, then asked again
+            ranges = kept.cast_fan(frame, directions, fan, 0.1, 10.0, same_rays=round_ > 0)
+            np.testing.assert_array_equal(ranges, expected)
+        seen.append(ranges)
+        # and against Bullet's own rays, where the geometry really is
+        hits = client.rayTestBatch([(0.0, 0.0, 0.3)] * 720,
+                                   list(map(tuple, (0, 0, 0.3) + 10.0 * directions)))
+        bullet = np.array([h[2] * 10.0 if h[0] >= 0 else np.inf for h in hits])
+        clear = bullet > 0.1 + BULLET_TOLERANCE             # no ray starting inside a crate
+        with np.errstate(invalid="ignore"):                 # inf - inf where both miss
+            agree = (ranges == bullet) | (np.abs(ranges - bullet) <= BULLET_TOLERANCE)
+        assert np.mean(agree[clear]) > 0.99, round_          # (Bullet errs on grazing beams)
+    # the scene did change under the fan, or this test would prove nothing
+    assert len({r.tobytes() for r in seen}) > 20
+
+
+def test_compiled_rotation_matrices_are_the_plain_float_arithmetic_to_the_bit():
+    """rotation_matrices runs compiled; its numbers must stay those of the plain IEEE
+    operations (no fused multiply-adds, no reordering), or placed shapes and so every
+    range would change in the last bits."""
+    q = np.random.default_rng(5).normal(size=(2000, 4))
+    q /= np.linalg.norm(q, axis=1)[:, None]
+    x, y, z, w = q.T
+    expected = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+                         2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+                         2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+                        axis=1).reshape(-1, 3, 3)
+    np.testing.assert_array_equal(rotation_matrices(q), expected)
+    np.testing.assert_array_equal(rotation_matrices(tuple(q[7])), expected[7:8])

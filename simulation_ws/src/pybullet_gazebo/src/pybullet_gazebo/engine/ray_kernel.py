@@ -293,6 +293,8 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
     windows = np.empty((3, 2), dtype=np.int64)
     culled = in_plane and fan[7] > 0.0
     if culled:
+        # (all shapes sorted: which of two hits at 0 m, +0.0 or -0.0, is kept depends on
+        # the order of the shapes that tie there)
         order, nearest = _nearest_first(origin, kind, position, rotation, size, bound)
     else:
         order, nearest = np.arange(kind.shape[0]), np.zeros(0)
@@ -327,10 +329,24 @@ def nearest_hits(origin, directions, plane_normal, kind, position, rotation, siz
                 along = rx * dx + ry * dy + rz * dz
                 if _misses_bound(along, distance2, reach, reach2, range_min, range_max):
                     continue
-                near, far = _interval(kind[j], size[j], ox, oy, oz,
-                                      r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz,
-                                      r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz,
-                                      r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz)
+                lx = r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz     # the ray in the shape's
+                ly = r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz     # frame
+                lz = r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz
+                if kind[j] == BOX:
+                    # _interval's slabs one by one: entering a slab beyond the nearest hit so
+                    # far, the ray cannot enter the box nearer (max() keeps an entry that
+                    # large, or gives NaN, which hits nothing); the rest as _interval does
+                    half = size[j]
+                    near_x, far_x = _slab(ox, lx, half[0])
+                    if near_x > out[i]:
+                        continue
+                    near_y, far_y = _slab(oy, ly, half[1])
+                    if near_y > out[i]:
+                        continue
+                    near_z, far_z = _slab(oz, lz, half[2])
+                    near, far = max(near_x, max(near_y, near_z)), min(far_x, min(far_y, far_z))
+                else:
+                    near, far = _interval(kind[j], size[j], ox, oy, oz, lx, ly, lz)
                 if near <= far and range_min <= near <= range_max and near < out[i]:
                     out[i] = near
 
@@ -409,6 +425,22 @@ def nearest_mesh_hits(origin, directions, plane_normal, position, rotation, boun
                     hit = _triangle_hit(ox, oy, oz, lx, ly, lz, triangles[t])
                     if range_min <= hit <= range_max and hit < out[i]:
                         out[i] = hit
+
+
+@njit(**_JIT)
+def rotation_matrices(quaternions, out):
+    """out (n, 3, 3) = the rotation matrices of quaternions (n, 4), unit, (x, y, z, w)."""
+    for k in range(quaternions.shape[0]):
+        x, y, z, w = quaternions[k, 0], quaternions[k, 1], quaternions[k, 2], quaternions[k, 3]
+        out[k, 0, 0] = 1.0 - 2.0 * (y * y + z * z)
+        out[k, 0, 1] = 2.0 * (x * y - z * w)
+        out[k, 0, 2] = 2.0 * (x * z + y * w)
+        out[k, 1, 0] = 2.0 * (x * y + z * w)
+        out[k, 1, 1] = 1.0 - 2.0 * (x * x + z * z)
+        out[k, 1, 2] = 2.0 * (y * z - x * w)
+        out[k, 2, 0] = 2.0 * (x * z - y * w)
+        out[k, 2, 1] = 2.0 * (y * z + x * w)
+        out[k, 2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
 @njit(**_JIT)
@@ -515,6 +547,9 @@ def warm_up():
                     np.array([0.0, 0.0, 0.0, 1.0]), np.array([[1.0, 0.0], [0.0, 1.0]]), 0.0,
                     math.pi / 2, frame, fan, directions)
     assert directions[1, 1] == 1.0 and frame[3, 2] == 1.0, (directions, frame)
+    matrix = np.empty((1, 3, 3))
+    rotation_matrices(np.array([[0.0, 0.0, 1.0, 0.0]]), matrix)      # half a turn about z
+    assert matrix[0, 0, 0] == -1.0 and matrix[0, 2, 2] == 1.0, matrix
     out = np.empty(2, dtype=np.float32)
     noisy_ranges(np.array([1.0, np.inf]), np.array([0.5, 0.5]), 0.0, 0.1, 0.1, 10.0, out)
     assert out[0] == np.float32(1.05) and out[1] == np.inf, out

@@ -87,7 +87,14 @@ class RaySensor(Part):
         self._frame = np.empty((4, 3))       # scratch of measure(): ray_kernel.fan_rays'
         self._fan = np.empty(8)
         self._directions = np.empty((samples, 3))
+        self._rays_pose = None               # the link pose those three were laid out at
         self._noisy = spec.noise_stddev > 0.0 or spec.noise_mean != 0.0
+        self._normals = np.empty(samples) if self._noisy else _NO_NOISE   # measure()'s draws
+        # the scan's numbers as measure() passes them on (the spec is frozen)
+        self._limits = (float(spec.min_angle), float(spec.max_angle), float(spec.range_min),
+                        float(spec.range_max), float(spec.noise_mean), float(spec.noise_stddev))
+        # bound once: a BulletClient makes a new partial at every attribute read
+        self._link_state = client.getLinkState
         if link_index == -1:
             # pybullet reports the base's centre of mass; the link frame is offset from it
             self._base_inertial = Pose(*client.getDynamicsInfo(body_id, -1)[3:5]).inverse()
@@ -151,8 +158,7 @@ class RaySensor(Part):
             link = Pose(*client.getBasePositionAndOrientation(self.body_id)).compose(
                 self._base_inertial)
             return link.position, link.orientation
-        state = client.getLinkState(self.body_id, self.link_index,
-                                    computeForwardKinematics=True)
+        state = self._link_state(self.body_id, self.link_index, computeForwardKinematics=True)
         return state[4], state[5]
 
     def sensor_pose(self):
@@ -161,26 +167,29 @@ class RaySensor(Part):
 
     def measure(self, sim_time):
         """Scan now; returns a LaserScanData stamped `sim_time` [s]."""
-        spec = self.spec
+        angle_min, angle_max, range_min, range_max, noise_mean, noise_stddev = self._limits
         position, orientation = self._link_frame()
         frame, fan, directions = self._frame, self._fan, self._directions
-        if not ray_kernel.fan_rays(np.asarray(position, dtype=float),
-                                   np.asarray(orientation, dtype=float), self._offset[0],
-                                   self._offset[1], self._cos_sin, float(spec.min_angle),
-                                   float(self.angle_increment), frame, fan, directions):
-            raise ValueError("ray sensor '%s': its link's pose is not finite" % spec.name)
-        ranges = self._caster.cast_fan(frame, directions, fan, spec.range_min,
-                                       spec.range_max, exclude_body=self.body_id)
+        pose = (tuple(position), tuple(orientation))
+        same_rays = pose == self._rays_pose   # a link at rest keeps its rays, to the bit
+        if not same_rays:
+            self._rays_pose = None
+            if not ray_kernel.fan_rays(np.asarray(position, dtype=float),
+                                       np.asarray(orientation, dtype=float), self._offset[0],
+                                       self._offset[1], self._cos_sin, angle_min,
+                                       self.angle_increment, frame, fan, directions):
+                raise ValueError("ray sensor '%s': its link's pose is not finite"
+                                 % self.spec.name)
+            self._rays_pose = pose
+        ranges = self._caster.cast_fan(frame, directions, fan, range_min, range_max,
+                                       exclude_body=self.body_id, same_rays=same_rays)
         # one draw per beam whether it hit or not, so the stream does not depend on the scene
-        normals = self.rng.standard_normal(len(ranges)) if self._noisy else _NO_NOISE
+        normals = self.rng.standard_normal(out=self._normals) if self._noisy else _NO_NOISE
         out = np.empty(len(ranges), dtype=np.float32)
-        ray_kernel.noisy_ranges(ranges, normals, float(spec.noise_mean),
-                                float(spec.noise_stddev), float(spec.range_min),
-                                float(spec.range_max), out)
+        ray_kernel.noisy_ranges(ranges, normals, noise_mean, noise_stddev, range_min, range_max,
+                                out)
         self._last = sim_time
         return LaserScanData(
-            stamp=sim_time, frame_id=self.frame_id,
-            angle_min=float(spec.min_angle), angle_max=float(spec.max_angle),
-            angle_increment=float(self.angle_increment), time_increment=0.0,
-            scan_time=self._period, range_min=float(spec.range_min),
-            range_max=float(spec.range_max), ranges=out)
+            stamp=sim_time, frame_id=self.frame_id, angle_min=angle_min, angle_max=angle_max,
+            angle_increment=self.angle_increment, time_increment=0.0, scan_time=self._period,
+            range_min=range_min, range_max=range_max, ranges=out)

@@ -2,8 +2,9 @@
 
 Bullet's own `rayTestBatch` costs about 3 ms for a 720-beam scan; this caster about 0.1 ms in
 the tutorial's world02. It reads the bodies' collision shapes once, keeps static ones in world
-coordinates (numpy arrays), reads dynamic ones' poses at each cast, and hands all shapes and
-rays to the compiled kernel `ray_kernel.nearest_hits`. That one drops shapes out of range or
+coordinates (numpy arrays), reads dynamic ones' poses at each cast and places again only the
+bodies whose pose changed (resting barrels keep their rows), and hands all shapes and rays
+to the compiled kernel `ray_kernel.nearest_hits`. That one drops shapes out of range or
 (when the rays share a plane, as a laser's do) not crossing that plane, skips the rays that
 miss a shape's bounding sphere, and solves the exact slab (box) or quadric (sphere,
 cylinder, capsule) intersection for the rest.
@@ -46,19 +47,19 @@ _ONES = np.ones(3)         # row sums as a matrix product, much faster than .sum
 
 def rotation_matrices(quaternions):
     """(n, 3, 3) rotation matrices of (n, 4) unit quaternions (x, y, z, w)."""
-    q = np.asarray(quaternions, dtype=float).reshape(-1, 4)
-    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    q = np.ascontiguousarray(quaternions, dtype=float).reshape(-1, 4)
     out = np.empty((len(q), 3, 3))
-    out[:, 0, 0] = 1 - 2 * (y * y + z * z)
-    out[:, 0, 1] = 2 * (x * y - z * w)
-    out[:, 0, 2] = 2 * (x * z + y * w)
-    out[:, 1, 0] = 2 * (x * y + z * w)
-    out[:, 1, 1] = 1 - 2 * (x * x + z * z)
-    out[:, 1, 2] = 2 * (y * z - x * w)
-    out[:, 2, 0] = 2 * (x * z - y * w)
-    out[:, 2, 1] = 2 * (y * z + x * w)
-    out[:, 2, 2] = 1 - 2 * (x * x + y * y)
+    ray_kernel.rotation_matrices(q, out)
     return out
+
+
+def _placed_frames(link_row, position, rotation, link_position, link_rotation):
+    """(position (n, 3), rotation (n, 3, 3)) in the world of frames given in their links'
+    inertial frames (position, rotation), the links at rows link_row of link_position
+    (m, 3) / link_rotation (m, 3, 3)."""
+    link_rotation = link_rotation[link_row]
+    return (link_position[link_row] + np.einsum("nij,nj->ni", link_rotation, position),
+            link_rotation @ rotation)
 
 
 class _Shapes:
@@ -96,10 +97,9 @@ class _Shapes:
     def placed(self, link_position, link_rotation):
         """These shapes moved to the world by their links' inertial poses (rows of
         link_position (m, 3) / link_rotation (m, 3, 3) picked by link_row)."""
-        rotation = link_rotation[self.link_row]
-        position = link_position[self.link_row] + np.einsum("nij,nj->ni", rotation,
-                                                            self.position)
-        return self.replace(position=position, rotation=rotation @ self.rotation)
+        position, rotation = _placed_frames(self.link_row, self.position, self.rotation,
+                                            link_position, link_rotation)
+        return self.replace(position=position, rotation=rotation)
 
     @staticmethod
     def concatenate(parts):
@@ -141,10 +141,9 @@ class _Meshes:
         return _Meshes(**arrays)
 
     def placed(self, link_position, link_rotation):
-        rotation = link_rotation[self.link_row]
-        position = link_position[self.link_row] + np.einsum("nij,nj->ni", rotation,
-                                                            self.position)
-        return self.replace(position=position, rotation=rotation @ self.rotation)
+        position, rotation = _placed_frames(self.link_row, self.position, self.rotation,
+                                            link_position, link_rotation)
+        return self.replace(position=position, rotation=rotation)
 
     @staticmethod
     def concatenate(parts):
@@ -173,53 +172,120 @@ class _Body:
         self.shapes = shapes                  # _Shapes in the links' inertial frames
         self.planes = planes                  # list of (link row, point (3,), normal (3,))
         self.meshes = meshes                  # _Meshes in the links' inertial frames, or None
+        self._joints = [i for i in links if i >= 0]
 
+    def read_pose(self, base_pose, link_states):
+        """The inertial poses of its links as pybullet reports them (a tuple of
+        ((x, y, z), (x, y, z, w)), one per link): compared exactly to tell whether the body
+        moved. base_pose, link_states: the client's getBasePositionAndOrientation and
+        getLinkStates."""
+        pose = (base_pose(self.body_id),) if self.links[0] == -1 else ()
+        if self._joints:
+            pose += tuple((state[0], state[1]) for state in
+                          link_states(self.body_id, self._joints, computeForwardKinematics=1))
+        return pose
 
-class _Group:
-    """Bodies whose poses are read together: their shapes with link rows numbered across the
-    group, so that one pass of numpy places them all."""
-
-    def __init__(self, bodies):
-        self.bodies = [b for b in bodies if b.links]
-        self.shapes, self.planes, meshes, offset = [], [], [], 0
-        for body in self.bodies:
-            self.shapes.append(body.shapes.replace(link_row=body.shapes.link_row + offset))
-            self.planes += [(body.body_id, row + offset, p, n) for row, p, n in body.planes]
-            if body.meshes is not None:
-                meshes.append(body.meshes.replace(link_row=body.meshes.link_row + offset))
-            offset += len(body.links)
-        self.shapes = _Shapes.concatenate(self.shapes) if self.shapes else None
-        self.meshes = _join_parts(meshes, _Meshes)
-        self._last = (None, None)            # (poses read, what place returned for them)
-
-    def place(self, client):
-        """(_Shapes or None, [(body, point, normal)], _Meshes or None) at the bodies' present
-        poses; the same objects as last time when no body moved (resting bodies sleep and do
-        not)."""
-        if not self.bodies:
-            return None, [], None
-        positions, orientations = [], []
-        base_pose = client.getBasePositionAndOrientation     # bound once for all bodies
-        for body in self.bodies:
-            if body.links[0] == -1:
-                pos, orn = base_pose(body.body_id)
-                positions.append(pos)
-                orientations.append(orn)
-            if body.links[-1] >= 0:
-                for state in client.getLinkStates(body.body_id, [i for i in body.links if i >= 0],
-                                                  computeForwardKinematics=1):
-                    positions.append(state[0])
-                    orientations.append(state[1])
-        if (positions, orientations) == self._last[0]:
-            return self._last[1]
-        position = np.asarray(positions, dtype=float)
-        rotation = rotation_matrices(orientations)
-        planes = [(body_id, position[row] + rotation[row] @ p, rotation[row] @ n)
-                  for body_id, row, p, n in self.planes]
-        shapes = self.shapes.placed(position, rotation) if self.shapes is not None else None
+    def placed(self, pose):
+        """(_Shapes, [(body, point, normal)], _Meshes or None): its shapes, planes and
+        meshes in the world with its links at `pose` (read_pose's)."""
+        position, rotation = self._link_frames(pose)
         meshes = self.meshes.placed(position, rotation) if self.meshes is not None else None
-        self._last = ((positions, orientations), (shapes, planes, meshes))
-        return shapes, planes, meshes
+        return (self.shapes.placed(position, rotation), self._placed_planes(position, rotation),
+                meshes)
+
+    def place_into(self, pose, shapes, shape_rows, meshes, mesh_rows):
+        """Writes its shapes' (and meshes') world frames with its links at `pose` into rows
+        shape_rows of `shapes` (mesh_rows of `meshes`); returns its planes in the world.
+        The same numbers placed() gives."""
+        position, rotation = self._link_frames(pose)
+        own = self.shapes
+        if len(own.body):
+            shapes.position[shape_rows], shapes.rotation[shape_rows] = _placed_frames(
+                own.link_row, own.position, own.rotation, position, rotation)
+        if self.meshes is not None:
+            own = self.meshes
+            meshes.position[mesh_rows], meshes.rotation[mesh_rows] = _placed_frames(
+                own.link_row, own.position, own.rotation, position, rotation)
+        return self._placed_planes(position, rotation)
+
+    @staticmethod
+    def _link_frames(pose):
+        return (np.array([p for p, _ in pose], dtype=float),
+                rotation_matrices([q for _, q in pose]))
+
+    def _placed_planes(self, position, rotation):
+        return [(self.body_id, position[row] + rotation[row] @ p, rotation[row] @ n)
+                for row, p, n in self.planes]
+
+
+class _Scene:
+    """What a cast that ignores one body (or none) sees, laid out for the kernels: the static
+    shapes and the other dynamic bodies' shapes in one set of arrays (static rows first, then
+    each dynamic body's in the caster's order), all planes, the static and the dynamic
+    meshes. A dynamic body's rows are placed again, in place, only when its links' poses
+    differ from those they were placed at (compared exactly, so the arrays hold what placing
+    them at every cast would give, bit for bit): resting bodies sleep and keep theirs."""
+
+    def __init__(self, static, bodies):
+        static_shapes, self._static_planes, self.static_meshes = static
+        self._bodies = [b for b in bodies if b.links]
+        rows, shape_parts, mesh_parts = 0, [], []
+        if static_shapes is not None and len(static_shapes.body):
+            shape_parts.append(static_shapes)
+            rows = len(static_shapes.body)
+        self._slices, mesh_rows = [], 0       # per dynamic body: its shape rows, mesh rows
+        for body in self._bodies:
+            count = len(body.shapes.body)
+            mesh_count = 0 if body.meshes is None else len(body.meshes.body)
+            self._slices.append((slice(rows, rows + count),
+                                 slice(mesh_rows, mesh_rows + mesh_count)))
+            rows, mesh_rows = rows + count, mesh_rows + mesh_count
+            shape_parts.append(body.shapes)
+            mesh_parts.append(body.meshes)
+        # copies (concatenate of one part copies too): the dynamic rows are written in place
+        self.shapes = _Shapes.concatenate(shape_parts) if rows else None
+        meshes = [m for m in mesh_parts if m is not None and len(m.body)]
+        self.dynamic_meshes = _Meshes.concatenate(meshes) if meshes else None
+        self._poses = [None] * len(self._bodies)
+        self.changes = 0                      # how many times some body was placed anew
+        self._planes = [[] for _ in self._bodies]
+        self.planes = list(self._static_planes)
+        # (index, body id) of the bodies with a base and no links, whose pose is one call's
+        # answer (most are: barrels, cans); the others read through _Body.read_pose
+        self._base_only = [(index, body.body_id) for index, body in enumerate(self._bodies)
+                           if body.links == [-1]]
+        self._linked = [index for index, body in enumerate(self._bodies)
+                        if body.links != [-1]]
+
+    def update(self, base_pose, link_states):
+        """Re-places the dynamic bodies that moved since the last update (all at the first)."""
+        poses, moved = self._poses, []
+        for index, body_id in self._base_only:
+            pose = (base_pose(body_id),)
+            if pose != poses[index]:
+                moved.append((index, pose))
+        for index in self._linked:
+            pose = self._bodies[index].read_pose(base_pose, link_states)
+            if pose != poses[index]:
+                moved.append((index, pose))
+        if moved:
+            self._place(moved)
+
+    def _place(self, moved):
+        """Writes the rows of the bodies moved, [(index, pose)]."""
+        self.changes += 1
+        planes_moved = False
+        for index, pose in moved:
+            body = self._bodies[index]
+            shape_rows, mesh_rows = self._slices[index]
+            planes = body.place_into(pose, self.shapes, shape_rows, self.dynamic_meshes,
+                                     mesh_rows)
+            if planes or self._planes[index]:
+                self._planes[index] = planes
+                planes_moved = True
+            self._poses[index] = pose
+        if planes_moved:
+            self.planes = self._static_planes + [p for body in self._planes for p in body]
 
 
 class RayCaster:
@@ -231,8 +297,11 @@ class RayCaster:
         self.skipped = []                     # (body id, link index) of shapes not cast against
         self._static_placed = {}              # body id -> its shapes and planes in the world
         self._static_cache = None             # all static shapes and planes in the world
-        self._dynamic_groups = {}             # exclude_body -> _Group of the other dynamics
-        self._joined = (None, None, None)     # (static, dynamic, both in one _Shapes)
+        self._scenes = {}                     # exclude_body -> _Scene
+        self._last_fan = None                 # cast_fan's last question and answer
+        # bound once: a BulletClient makes a new partial at every attribute read
+        self._base_pose = client.getBasePositionAndOrientation
+        self._link_states = client.getLinkStates
 
     # --- the set of bodies --------------------------------------------------------------
     def add_body(self, body_id, static, base_shapes=None):
@@ -299,24 +368,31 @@ class RayCaster:
                      meshes)
         self._bodies[body_id] = body
         if body.static:
-            self._static_placed[body_id] = _Group([body]).place(client)
+            self._static_placed[body_id] = self._placed(body)
         self._static_cache = None
-        self._dynamic_groups = {}
+        self._scenes = {}
 
     def remove_body(self, body_id):
         """Forget `body_id` (no error when it was not added)."""
         if self._bodies.pop(body_id, None) is not None:
             self._static_placed.pop(body_id, None)
             self._static_cache = None
-            self._dynamic_groups = {}
+            self._scenes = {}
         self.skipped = [s for s in self.skipped if s[0] != body_id]
 
     def reset(self):
         """Re-read the poses of the static bodies (after some of them were moved)."""
         for body_id, body in self._bodies.items():
             if body.static:
-                self._static_placed[body_id] = _Group([body]).place(self._client)
+                self._static_placed[body_id] = self._placed(body)
         self._static_cache = None
+        self._scenes = {}
+
+    def _placed(self, body):
+        """body's shapes, planes, meshes (see _Body.placed) at its present pose."""
+        if not body.links:
+            return None, [], None
+        return body.placed(body.read_pose(self._base_pose, self._link_states))
 
     def _static(self):
         """All static shapes in one _Shapes (or None), all static planes, all static meshes
@@ -329,14 +405,16 @@ class RayCaster:
                                   _join_parts([m for _, _, m in placed], _Meshes))
         return self._static_cache
 
-    def _dynamic(self, exclude_body):
-        """The dynamic bodies other than exclude_body, placed at their present poses."""
-        group = self._dynamic_groups.get(exclude_body)
-        if group is None:
-            group = _Group(b for b in self._bodies.values()
-                           if not b.static and b.body_id != exclude_body)
-            self._dynamic_groups[exclude_body] = group
-        return group.place(self._client)
+    def _scene(self, exclude_body):
+        """The _Scene of casts ignoring exclude_body, its dynamic bodies at their present
+        poses."""
+        scene = self._scenes.get(exclude_body)
+        if scene is None:
+            scene = _Scene(self._static(), (b for b in self._bodies.values()
+                                            if not b.static and b.body_id != exclude_body))
+            self._scenes[exclude_body] = scene
+        scene.update(self._base_pose, self._link_states)
+        return scene
 
     # --- casting -------------------------------------------------------------------------
     def cast(self, origin, directions, range_min, range_max, exclude_body=None, fan=None):
@@ -358,34 +436,47 @@ class RayCaster:
                              exclude_body)
 
     def cast_fan(self, frame, directions, fan, range_min, range_max, exclude_body=None,
-                 cull=True):
+                 cull=True, same_rays=False):
         """A laser's fan, as ray_kernel.fan_rays lays it out: frame (4, 3) the sensor's
         origin and x, y, z axes, directions (n, 3) unit vectors in its xy plane, fan (8,)
-        the kernels' fan. Distances as cast() gives them; `cull`: try each shape only on
-        the beams that can reach it (the same distances to the last bit as without)."""
-        return self._nearest(frame[0], directions, frame[3], fan if cull else ray_kernel.NO_FAN,
-                             range_min, range_max, exclude_body)
+        the kernels' fan. Distances as cast() gives them (a new array each call); `cull`:
+        try each shape only on the beams that can reach it (the same distances to the last
+        bit as without). `same_rays`: the caller's word that these three arrays are the
+        ones it passed at its last call, unchanged since (a laser at rest); asked again so
+        with the same ranges and no body moved since, the last answer is given again
+        without casting."""
+        fan = fan if cull else ray_kernel.NO_FAN
+        scene = self._scene(exclude_body)
+        question = (range_min, range_max, exclude_body, cull, scene, scene.changes)
+        last = self._last_fan
+        if same_rays and last is not None and last[0] is directions and last[1] == question:
+            return last[2].copy()
+        ranges = self._nearest(frame[0], directions, frame[3], fan, range_min, range_max,
+                               exclude_body, scene)
+        self._last_fan = (directions, question, ranges.copy())
+        return ranges
 
-    def _nearest(self, origin, directions, normal, fan, range_min, range_max, exclude_body):
+    def _nearest(self, origin, directions, normal, fan, range_min, range_max, exclude_body,
+                 scene=None):
         """The distances to the nearest hits, inf where none (cast's job once its rays are
         checked): normal, the unit normal of a plane through origin holding every ray, or
-        None; fan, the kernels' fan or NO_FAN."""
+        None; fan, the kernels' fan or NO_FAN; scene: _scene(exclude_body) when just got."""
         result = np.full(len(directions), np.inf)
         range_min = max(0.0, float(range_min))
         range_max = float(range_max)
         if not range_min < range_max or len(directions) == 0:
             return result
-        static_shapes, static_planes, static_meshes = self._static()
-        dynamic_shapes, dynamic_planes, dynamic_meshes = self._dynamic(exclude_body)
-        for body_id, point, plane_normal in static_planes + dynamic_planes:
+        if scene is None:
+            scene = self._scene(exclude_body)
+        for body_id, point, plane_normal in scene.planes:
             if body_id != exclude_body:
                 np.minimum(result, self._plane_hits(origin, directions, point, plane_normal,
                                                     range_min, range_max), out=result)
-        shapes = self._join(static_shapes, dynamic_shapes)
+        shapes = scene.shapes
         if normal is None:
             normal, fan = _NO_PLANE, ray_kernel.NO_FAN
         exclude = -1 if exclude_body is None else int(exclude_body)
-        for meshes in (static_meshes, dynamic_meshes):
+        for meshes in (scene.static_meshes, scene.dynamic_meshes):
             if meshes is not None:
                 ray_kernel.nearest_mesh_hits(
                     origin, directions, normal, meshes.position, meshes.rotation, meshes.bound,
@@ -396,15 +487,6 @@ class RayCaster:
                                     shapes.rotation, shapes.size, shapes.bound, shapes.body,
                                     exclude, range_min, range_max, result, fan)
         return result
-
-    def _join(self, static_shapes, dynamic_shapes):
-        """Both sets in one _Shapes (or None); reused while neither changed."""
-        if self._joined[0] is static_shapes and self._joined[1] is dynamic_shapes:
-            return self._joined[2]
-        parts = [s for s in (static_shapes, dynamic_shapes) if s is not None]
-        joined = (_Shapes.concatenate(parts) if len(parts) > 1 else parts[0]) if parts else None
-        self._joined = (static_shapes, dynamic_shapes, joined)
-        return joined
 
     @staticmethod
     def _plane_hits(origin, directions, point, normal, range_min, range_max):
