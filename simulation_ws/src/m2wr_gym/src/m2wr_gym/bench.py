@@ -14,10 +14,12 @@
    steppers in two processes at once against one. Also the CPU each side spends (workers
    per env step, the learner's process per vector step, from /proc) and how busy the two
    cores were: what separates the figure from the ceiling. Odd rounds run in reverse order.
-3. Where one in-process control step's CPU time goes (see breakdown()): Bullet's physics,
-   the engine's work around it, the one scan observed, the environment's own Python.
+3. Where one in-process control step's CPU time goes, timed inside the env's own steps (see
+   breakdown()): Bullet's physics, the contact guard and reads, the one scan observed, the
+   rest of the engine, the environment's own Python.
 Measurements alternate in rounds (--rounds); for 1 and 3 the best round of each is kept, so a
-busy moment of a shared machine hits both sides alike; for 2 the median of the same-round
+busy moment of a shared machine hits both sides alike (1 also as the median of the
+same-round ratios); for 2 the median of the same-round
 ratios (with their range). The in-process figures are also given per
 second of this process's CPU time, which other programs on a shared machine disturb less
 than wall time (but still: note the load, `uptime`, with any figure).
@@ -120,43 +122,63 @@ def one_env(steps, seed=0):
     return steps * dt / wall, steps / wall, steps * dt / cpu
 
 
+@contextlib.contextmanager
+def _timed(timers, owner, name, key):
+    """owner.name (a class's method) adds its CPU time [s] and calls to timers[key] while
+    inside; put back after."""
+    original = getattr(owner, name)
+    cpu = time.process_time
+
+    def timed(*args, **kwargs):
+        started = cpu()
+        try:
+            return original(*args, **kwargs)
+        finally:
+            timers[key][0] += cpu() - started
+            timers[key][1] += 1
+
+    timers[key] = [0.0, 0]
+    setattr(owner, name, timed)
+    try:
+        yield
+    finally:
+        setattr(owner, name, original)
+
+
 def breakdown(steps, seed=0):
-    """Where one control step's CPU time goes in process, [us] each (same env, same run):
-    the whole env.step; Bullet's stepSimulation alone for the step's physics steps, one call
-    each; the engine's work around them (drive, schedules, contacts, batching: World.advance
-    without readings, as the env steps, minus that physics: negative when batching saves
-    more of Bullet's per-call cost than the engine spends); the one scan observed; the rest
-    is the environment's own Python."""
+    """Where the CPU time of the env's own steps goes, [us] per env step: the whole env.step
+    and, timed inside those same steps, Bullet's physics (the Batcher's stepSimulation
+    calls, batched as the engine runs them), the contact guard (Batcher.safe_time), the
+    contact reads (ContactTracker.update), the one scan observed (RaySensor.measure), the
+    rest of the engine (World.advance's loop, the drive, schedules) and the environment's
+    own Python (observation, reward, info, gymnasium's wrappers). Each timer costs ~1 us a
+    call, counted in its part. Also the Bullet calls per env step."""
+    from pybullet_gazebo.engine.batching import Batcher
+    from pybullet_gazebo.engine.contacts import ContactTracker
+    from pybullet_gazebo.engine.ray_sensor import RaySensor
+    from .sim_inprocess import InProcessSim
     env = make()
     env.action_space.seed(seed)
     env.reset(seed=seed)
-    sim, per_action = env.unwrapped.sim, env.unwrapped.options.steps_per_action
-    cpu = time.process_time
-    started = cpu()
-    for _ in range(steps):
-        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
-        if terminated or truncated:
-            env.reset()
-    whole = (cpu() - started) / steps
-    world, bullet_step = sim.world, sim.client.stepSimulation
-    engine = physics = scan = 0.0
-    for _ in range(steps):                 # alternating, so both meet the same scenes
-        sim._drive.set_command(*env.action_space.sample())
-        started = cpu()
-        world.advance(per_action, collect=())
-        engine += cpu() - started
-        started = cpu()
-        for _ in range(per_action):
-            bullet_step()
-        physics += cpu() - started
-        started = cpu()
-        sim._laser.measure(world.sim_time)
-        scan += cpu() - started
+    timers = {}
+    with contextlib.ExitStack() as stack:
+        for owner, name, key in ((Batcher, "step", "physics"), (Batcher, "safe_time", "guard"),
+                                 (ContactTracker, "update", "contacts"),
+                                 (RaySensor, "measure", "scan"), (InProcessSim, "run", "sim")):
+            stack.enter_context(_timed(timers, owner, name, key))
+        started = time.process_time()
+        for _ in range(steps):
+            _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+            if terminated or truncated:
+                env.reset()
+        whole = time.process_time() - started
     env.close()
-    physics, scan = physics / steps, scan / steps
-    engine = engine / steps - physics
-    return {"env step": whole * 1e6, "physics": physics * 1e6, "engine": engine * 1e6,
-            "scan": scan * 1e6, "env": (whole - physics - engine - scan) * 1e6}
+    us = {key: seconds / steps * 1e6 for key, (seconds, _) in timers.items()}
+    return {"env step": whole / steps * 1e6, "physics": us["physics"], "guard": us["guard"],
+            "contacts": us["contacts"], "scan": us["scan"],
+            "engine": us["sim"] - us["physics"] - us["guard"] - us["contacts"] - us["scan"],
+            "env": whole / steps * 1e6 - us["sim"],
+            "bullet calls": timers["physics"][1] / steps}
 
 
 WARMUP = 10          # env steps after each reset before timing (pages touched, caches filled)
@@ -405,13 +427,16 @@ def print_env_summary(args, bare, env_rate, env_steps, bare_cpu, env_cpu, parts_
     print("  environment / bare Bullet:               %6.2f" % (max(env_rate) / max(bare)))
     print("  per CPU second: bare Bullet %.0f, environment %.0f sim s; ratio %.2f"
           % (max(bare_cpu), max(env_cpu), max(env_cpu) / max(bare_cpu)))
+    ratios = sorted(e / b for e, b in zip(env_rate, bare))
+    print("  the same, round by round: median %.2f (range %.2f-%.2f)"
+          % (float(np.median(ratios)), ratios[0], ratios[-1]))
     parts = min(parts_by_round, key=lambda parts: parts["env step"])
     print("  CPU per env step in process [us] (round with the least): %.0f = Bullet's physics "
-          "%.0f + engine around it %.0f + one scan %.0f + environment %.0f; "
-          "env / bare Bullet from these: %.2f"
-          % (parts["env step"], parts["physics"], parts["engine"], parts["scan"], parts["env"],
+          "%.0f (%.1f calls) + contact guard %.0f + contact reads %.0f + one scan %.0f + rest "
+          "of the engine %.0f + environment %.0f; env / physics: %.2f"
+          % (parts["env step"], parts["physics"], parts["bullet calls"], parts["guard"],
+             parts["contacts"], parts["scan"], parts["engine"], parts["env"],
              parts["physics"] / parts["env step"]))
-
 
 if __name__ == "__main__":
     try:
