@@ -1,10 +1,11 @@
 """Speed figures of the environments (printed, never asserted): `python -m m2wr_gym.bench`.
 
 1. One in-process environment (world02, 10 Hz control, 720-beam scan, random continuous
-   actions, episodes of 120 s from random free starts, resets included) against bare Bullet:
-   the same world and m2wr built by the same World, driven by a constant command, stepped with
-   client.stepSimulation() alone (no laser, no drive updates, no contacts). Both as sim
-   seconds per wall second; the ratio is the environment's share of Bullet's speed.
+   actions drawn before the timing, episodes of 120 s from random free starts, resets
+   included) against bare Bullet: the same world and m2wr built by the same World, driven
+   by a constant command, stepped with client.stepSimulation() alone (no laser, no drive
+   updates, no contacts). Both as sim seconds per wall second; the ratio is the
+   environment's share of Bullet's speed.
 2. Vectorised (--part vector): the same two episodes (seeds s and s + 1, random free starts,
    actions drawn ahead, so no sampler runs in the timed loops) stepped in this process one
    after the other, in one subprocess (an AsyncVectorEnv of one), in two subprocesses at
@@ -107,13 +108,20 @@ def two_bare_bullets(seconds):
                 worker.join()
 
 
+def drawn_actions(env, steps, seed):
+    """`steps` random actions of env's action space, drawn before any timing: the sampler
+    (gymnasium's Box.sample, ~25 us) is the learner's work, not the environment's."""
+    env.action_space.seed(seed)
+    return [env.action_space.sample() for _ in range(steps)]
+
+
 def one_env(steps, seed=0):
     env = make()
-    env.action_space.seed(seed)
+    actions_ahead = drawn_actions(env, steps, seed)
     env.reset(seed=seed)
     started, cpu_started = time.perf_counter(), time.process_time()
-    for _ in range(steps):
-        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+    for action in actions_ahead:
+        _, _, terminated, truncated, _ = env.step(action)
         if terminated or truncated:
             env.reset()
     wall, cpu = time.perf_counter() - started, time.process_time() - cpu_started
@@ -158,7 +166,7 @@ def breakdown(steps, seed=0):
     from pybullet_gazebo.engine.ray_sensor import RaySensor
     from .sim_inprocess import InProcessSim
     env = make()
-    env.action_space.seed(seed)
+    actions_ahead = drawn_actions(env, steps, seed)
     env.reset(seed=seed)
     timers = {}
     with contextlib.ExitStack() as stack:
@@ -167,8 +175,8 @@ def breakdown(steps, seed=0):
                                  (RaySensor, "measure", "scan"), (InProcessSim, "run", "sim")):
             stack.enter_context(_timed(timers, owner, name, key))
         started = time.process_time()
-        for _ in range(steps):
-            _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        for action in actions_ahead:
+            _, _, terminated, truncated, _ = env.step(action)
             if terminated or truncated:
                 env.reset()
         whole = time.process_time() - started
