@@ -48,8 +48,28 @@ def space(kind):
                       dtype=np.float32)
 
 
+_COMMANDS = {left_sign(turning): tuple((float(v), float(w)) for v, w in discrete_table(turning))
+             for turning in TURNINGS}  # discrete_table's rows as Python floats, by left_sign
+_LINEAR_LIMIT = MAX_LINEAR + 1e-6     # [m/s] the bounds with to_command's tolerance
+_ANGULAR_LIMIT = MAX_ANGULAR + 1e-6   # [rad/s]
+
+
 def to_command(kind, action, turning):
-    """(linear.x, angular.z) for an action; InvalidAction naming it when it is not one."""
+    """(linear.x, angular.z) for an action; InvalidAction naming it when it is not one.
+
+    A continuous action given as a float16/32/64 array of shape (2,) within the bounds (what
+    the space's sample() and most policies give) takes a short way to the same result;
+    anything else, and every error, goes through the full checks (once per environment step:
+    ~1 us instead of ~5)."""
+    if (kind == "continuous" and type(action) is np.ndarray and action.shape == (2,)
+            and action.dtype.char in "efd"):
+        v, w = action.tolist()                 # Python floats, exactly the array's values
+        if abs(v) <= _LINEAR_LIMIT and abs(w) <= _ANGULAR_LIMIT:    # False for NaN and inf
+            return v, w
+    return _checked_command(kind, action, turning)
+
+
+def _checked_command(kind, action, turning):
     if kind == "discrete":
         try:
             index = int(action)
@@ -59,8 +79,7 @@ def to_command(kind, action, turning):
         if not valid:
             raise InvalidAction("action %r is not one of 0 (forward), 1 (left), 2 (right)"
                                 % (action,))
-        v, w = discrete_table(turning)[index]
-        return float(v), float(w)
+        return _COMMANDS[left_sign(turning)][index]
     try:
         values = np.asarray(action, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError):
@@ -72,8 +91,7 @@ def to_command(kind, action, turning):
     if not np.all(np.isfinite(values)):
         raise InvalidAction("action %r holds NaN or inf" % (action,))
     v, w = values
-    tolerance = 1e-6
-    if abs(v) > MAX_LINEAR + tolerance or abs(w) > MAX_ANGULAR + tolerance:
+    if abs(v) > _LINEAR_LIMIT or abs(w) > _ANGULAR_LIMIT:
         raise InvalidAction("action %r is out of range: |linear.x| <= %g m/s, |angular.z| <= %g "
                             "rad/s" % (action, MAX_LINEAR, MAX_ANGULAR))
     return float(v), float(w)

@@ -62,7 +62,10 @@ class M2wrEnv(gymnasium.Env):
         self._picture = None
         self._snapshot = None
         self._goal = None
-        self._path = []
+        self._path = None         # [(x, y, yaw)] of the episode, kept for rgb_array pictures only
+        self._steps_per_action = options.steps_per_action
+        self._goal_task = options.task == "goal"
+        self._laser_size = laser
 
     # --- construction -----------------------------------------------------------------
     def _make_backend(self):
@@ -130,7 +133,8 @@ class M2wrEnv(gymnasium.Env):
         self._snapshot = self.sim.reset(*start, seed=world_seed)
         self._steps = 0
         self._distance = 0.0
-        self._path = [(self._snapshot.x, self._snapshot.y, self._snapshot.yaw)]
+        if self.render_mode == "rgb_array":
+            self._path = [(self._snapshot.x, self._snapshot.y, self._snapshot.yaw)]
         return self._observe(), self._info((0.0, 0.0))
 
     def _draw_goal(self, rng, start):
@@ -141,44 +145,55 @@ class M2wrEnv(gymnasium.Env):
         raise RuntimeError("no goal found at least 1 m from the start; pass goal=(x, y)")
 
     def step(self, action):
-        if self._snapshot is None:
+        # (once per step: locals instead of repeated attribute look-ups, no numpy on tiny
+        # arrays; the results are bit for bit those of the plain version)
+        before = self._snapshot
+        if before is None:
             raise RuntimeError("call reset() before step()")
+        options = self.options
         try:
-            command = actions.to_command(self.options.action, action, self.options.turning)
+            command = actions.to_command(options.action, action, options.turning)
         except actions.InvalidAction as err:
-            if self.options.invalid_action == "raise":
+            if options.invalid_action == "raise":
                 raise
             LOG.error("m2wr_gym: %s; the episode is truncated (invalid_action='end')", err)
             info = self._info((0.0, 0.0))
             info["invalid_action"] = str(err)
             return self._observe(), 0.0, False, True, info
-        before = self._snapshot
-        after = self.sim.run(*command, steps=self.options.steps_per_action)
+        after = self.sim.run(command[0], command[1], steps=self._steps_per_action)
         self._snapshot = after
         self._steps += 1
-        self._distance += math.hypot(after.x - before.x, after.y - before.y)
-        self._path.append((after.x, after.y, after.yaw))
-        pose0, pose1 = (before.x, before.y, before.yaw), (after.x, after.y, after.yaw)
+        x, y, yaw, touched = after.x, after.y, after.yaw, after.touched
+        self._distance += math.hypot(x - before.x, y - before.y)
+        if self._path is not None:
+            self._path.append((x, y, yaw))
+        pose0, pose1 = (before.x, before.y, before.yaw), (x, y, yaw)
         nearest = _nearest(after.ranges)
-        if self.options.task == "avoid":
-            reward, terminated = tasks.avoid_reward(pose0, pose1, nearest, after.touched)
-        else:
+        if self._goal_task:
             reward, terminated = tasks.goal_reward(pose0, pose1, self._goal,
-                                                   self.options.goal_tolerance, nearest,
-                                                   after.touched)
-        if terminated and after.touched and not self.options.end_on_contact:
+                                                   options.goal_tolerance, nearest, touched)
+        else:
+            reward, terminated = tasks.avoid_reward(pose0, pose1, nearest, touched)
+        if terminated and touched and not options.end_on_contact:
             terminated = False
         truncated = not terminated and self._steps >= self.max_steps
         return self._observe(), float(reward), terminated, truncated, self._info(command, nearest)
 
     def _observe(self):
         s = self._snapshot
-        laser = observation.laser_features(self.options.observation, s.ranges, s.range_max,
-                                           self.options.downsample)
-        if self.options.task == "goal":
-            goal = np.clip(observation.goal_in_robot_frame(self._goal, s.x, s.y, s.yaw),
-                           -GOAL_RANGE, GOAL_RANGE)
-            return np.concatenate([laser, goal]).astype(np.float32)
+        options = self.options
+        laser = observation.laser_features(options.observation, s.ranges, s.range_max,
+                                           options.downsample)
+        if self._goal_task:
+            # the goal rounded to float32 then clipped to +-GOAL_RANGE, as np.clip of
+            # goal_in_robot_frame would: clipping first gives the same float32 (+-30 is exact)
+            n = self._laser_size
+            features = np.empty(n + 2, np.float32)
+            features[:n] = laser
+            gx, gy = observation.goal_offset(self._goal, s.x, s.y, s.yaw)
+            features[n] = min(max(gx, -GOAL_RANGE), GOAL_RANGE)
+            features[n + 1] = min(max(gy, -GOAL_RANGE), GOAL_RANGE)
+            return features
         return laser.astype(np.float32, copy=False)      # (a new array already)
 
     def _info(self, command, nearest=None):

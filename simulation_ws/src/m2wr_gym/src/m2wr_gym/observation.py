@@ -7,7 +7,8 @@ motion_plan/learned_avoidance.py (numpy only: no ROS, no pybullet, no torch).
 - "scan": the ranges [m] with +inf (no return, REP 117) replaced by range_max, optionally
   downsampled by taking the minimum of each group of `downsample` consecutive beams (the
   nearest thing in each sector is kept, never skipped over).
-- goal_in_robot_frame(): the goal (x, y) [m] in the robot's frame (x forward, y left).
+- goal_in_robot_frame(): the goal (x, y) [m] in the robot's frame (x forward, y left)
+  (goal_offset(): the same as two Python floats).
 """
 import math
 
@@ -17,6 +18,7 @@ REGION_SLICES = ((0, 143), (144, 287), (288, 431), (432, 575), (576, 713))  # re
 REGION_CAP = 10.0           # [m] reading_laser.py's min(..., 10)
 SCAN_BEAMS = 720            # m2wr's laser
 KINDS = ("regions", "scan")
+_REGION_BOUNDS = np.array([i for bounds in REGION_SLICES for i in bounds], dtype=np.intp)
 
 
 def regions(ranges):
@@ -25,8 +27,8 @@ def regions(ranges):
     if ranges.shape != (SCAN_BEAMS,):
         raise ValueError("a scan of %d beams is needed for the five regions (m2wr's laser); "
                          "got %s" % (SCAN_BEAMS, ranges.shape))
-    return np.array([min(float(ranges[a:b].min()), REGION_CAP) for a, b in REGION_SLICES],
-                    dtype=np.float32)
+    # one reduceat over the bounds [a0, b0, a1, b1, ...]: its even entries are the slices' minima
+    return np.minimum(np.minimum.reduceat(ranges, _REGION_BOUNDS)[::2], np.float32(REGION_CAP))
 
 
 def scan(ranges, range_max, downsample=1):
@@ -55,7 +57,12 @@ def laser_features(kind, ranges, range_max, downsample=1):
 
 
 def goal_in_robot_frame(goal, x, y, yaw):
-    """(x, y) [m] of the goal in the frame of a robot at (x, y, yaw)."""
+    """(x, y) [m] of the goal in the frame of a robot at (x, y, yaw), float32 (2,)."""
+    return np.array(goal_offset(goal, x, y, yaw), dtype=np.float32)
+
+
+def goal_offset(goal, x, y, yaw):
+    """goal_in_robot_frame as two Python floats (before the float32 rounding)."""
     dx, dy = goal[0] - x, goal[1] - y
     c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([c * dx + s * dy, -s * dx + c * dy], dtype=np.float32)
+    return c * dx + s * dy, -s * dx + c * dy
