@@ -194,7 +194,7 @@ class M2wrEnv(gymnasium.Env):
             features[n] = min(max(gx, -GOAL_RANGE), GOAL_RANGE)
             features[n + 1] = min(max(gy, -GOAL_RANGE), GOAL_RANGE)
             return features
-        return laser.astype(np.float32, copy=False)      # (a new array already)
+        return laser          # (float32 and a new array already: see observation.py)
 
     def _info(self, command, nearest=None):
         s = self._snapshot
