@@ -1,5 +1,6 @@
 """The short ways a step takes give what the plain ways give: the command for an action, the
-five regions (reading_laser.py's numbers, NaN and inf included), the goal part of the
+five regions (reading_laser.py's numbers, NaN and inf included), the scan with no-returns
+set to range_max, the goal part of the
 goal task's observation (np.clip of goal_in_robot_frame), bit for bit."""
 import math
 
@@ -86,6 +87,21 @@ def test_regions_equal_one_min_per_slice_with_inf_and_nan():
         assert got.dtype == np.float32 and got.tobytes() == want.tobytes()
     as_tuple = tuple(float(r) for r in ranges)           # as a LaserScan's ranges arrive
     assert observation.regions(as_tuple).tobytes() == reading_laser_regions(ranges).tobytes()
+
+
+@pytest.mark.parametrize("downsample", [1, 4])
+def test_scan_replaces_every_non_finite_range_by_range_max(downsample):
+    rng = np.random.default_rng(3)
+    ranges = rng.uniform(0.1, 12.0, 720).astype(np.float32)
+    ranges[rng.integers(0, 720, 200)] = np.inf
+    ranges[[5, 6, 400]] = [np.nan, -np.inf, np.nan]
+    want = np.where(np.isfinite(ranges), ranges, np.float32(10.0))
+    want = want.reshape(-1, downsample).min(axis=1)
+    got = observation.scan(ranges, 10.0, downsample)
+    assert got.dtype == np.float32 and got.tobytes() == want.tobytes()
+    assert np.isinf(ranges).sum() >= 150                    # the scan given is left as it was
+    as_tuple = tuple(float(r) for r in ranges)               # as a LaserScan's ranges arrive
+    assert observation.scan(as_tuple, 10.0, downsample).tobytes() == want.tobytes()
 
 
 @pytest.mark.parametrize("goal", [(1.5, 7.0), (100.0, 8.0), (-50.0, -40.0)])
