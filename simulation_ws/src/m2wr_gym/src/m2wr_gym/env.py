@@ -214,7 +214,7 @@ class M2wrEnv(gymnasium.Env):
         s = self._snapshot
         scan = None if s is None else (s.ranges, -math.pi / 2, math.pi / (len(s.ranges) - 1))
         title = "%s, t = %.1f s" % (self.options.task, s.sim_time if s else 0.0)
-        return self._picture.draw(self._path, scan, self._goal, title)
+        return self._picture.draw(self._path or [], scan, self._goal, title)
 
     def clearance(self, within=np.inf):
         """Smallest distance [m] from m2wr's footprint to an obstacle's, now (0 = touching;
