@@ -21,6 +21,8 @@ SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 MODELS = os.path.join(SRC, "pybullet_gazebo", "models")
 STEP = 0.005          # [s]
 CONTROL = 20          # physics steps per command, as the Gym environment's 10 Hz
+# world02: m2wr on its wheels heading -y, row A's face ~1.7 m ahead (0.5 m/s reaches it)
+FACING_ROW_A = Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2)
 
 
 @pytest.fixture(scope="module")
@@ -131,8 +133,7 @@ def test_driving_into_a_barrier_gives_the_same_contact_events(make_world, world0
     runs = {}
     for batched in (False, True):
         world = make_world(world02)
-        robot = world.spawn_urdf("m2wr", m2wr_urdf,
-                                 Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2))
+        robot = world.spawn_urdf("m2wr", m2wr_urdf, FACING_ROW_A)
         calls = Calls(world)
         runs[batched] = drive(world, robot, [(0.5, 0.0)] * 30 + [(-0.5, 0.0)] * 5, batched), calls
     (single, single_events), _ = runs[False]
@@ -150,11 +151,10 @@ def test_until_news_stops_at_each_reading_and_each_change_of_touches(make_world,
     call ends at the step that brought readings or changed the touches, never later, so
     each is published at its own sim time; and the run is bit for bit single stepping's."""
     commands = [(0.5, 0.0)] * 30 + [(-0.5, 0.0)] * 5         # into row A's face and back
-    pose = Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2)
     single_world = make_world(world02)
-    single_robot = single_world.spawn_urdf("m2wr", m2wr_urdf, pose)
+    single_robot = single_world.spawn_urdf("m2wr", m2wr_urdf, FACING_ROW_A)
     world = make_world(world02)
-    robot = world.spawn_urdf("m2wr", m2wr_urdf, pose)
+    robot = world.spawn_urdf("m2wr", m2wr_urdf, FACING_ROW_A)
     calls = Calls(world)
     parts = [next(p for p in r.parts if isinstance(p, DiffDrive)) for r in (single_robot, robot)]
     news_steps, single_news = [], []
@@ -189,7 +189,7 @@ def test_pressed_on_a_barrier_it_steps_one_by_one_and_reads_contacts_after_each(
     the contacts are read after each (the events match single stepping: test above), but
     the parts' hooks run only at their own times, not at every step."""
     world = make_world(world02)
-    robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2))
+    robot = world.spawn_urdf("m2wr", m2wr_urdf, FACING_ROW_A)
     drive(world, robot, [(0.5, 0.0)] * 30, batched=True)          # on the barrier by now
     assert world.touching()
     calls, counts = Calls(world), {"reads": 0, "hooks": 0}
@@ -383,8 +383,7 @@ def test_touching_at_the_end_of_a_call_then_moved_away_batches_again(make_world,
     runs = {}
     for batched in (False, True):
         world = make_world(world02)
-        robot = world.spawn_urdf("m2wr", m2wr_urdf,
-                                 Pose.from_xyz_rpy(0, 7.0, 0.1, 0, 0, -math.pi / 2))
+        robot = world.spawn_urdf("m2wr", m2wr_urdf, FACING_ROW_A)
         calls = Calls(world)
         marks = {}
 
