@@ -7,7 +7,6 @@ pose resting on its wheels: Bullet keeps contact caches across teleports, so a r
 is what makes an episode depend on its seed and actions only.
 """
 from dataclasses import dataclass
-import math
 import xml.etree.ElementTree as ET
 
 import numpy as np

@@ -4,7 +4,6 @@ stepping one step at a time gives, and the stretches really are batched."""
 import math
 import os
 
-import numpy as np
 import pybullet
 import pytest
 import xacro

@@ -28,7 +28,6 @@ tests the segment [range_min, range_max] along its direction; hits nearer than r
 ignored as if the ray started there, and a ray starting inside a shape does not hit that
 shape. Distances are measured from the origin [m]; no hit is `inf`.
 """
-import math
 
 import numpy as np
 import pybullet
