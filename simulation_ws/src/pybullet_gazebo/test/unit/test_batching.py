@@ -311,13 +311,14 @@ def test_safe_time_shrinks_near_an_obstacle(make_world, world02, m2wr_urdf):
     assert world._batcher.safe_time(robots, others, grounds, 0.1) < 2 * STEP
 
 
-def test_a_20_hz_drive_and_laser_cost_four_bullet_calls_per_0_1_s(make_world, world02,
-                                                                 m2wr_urdf):
-    """In the open (row A 2 m to the side) the drive's 20 Hz updates and the laser's 20 Hz
-    scans, one step apart, cut each 20 steps into 9 + 1 + 9 + 1 and nothing more: the drive's
-    schedule, which adds its period to its last time, runs a few 1e-17 s ahead of the steps'
-    times, and that rounding must not cost a Bullet call of its own (it cost two in three
-    of every ten commands)."""
+def test_a_20_hz_drive_and_laser_cost_three_bullet_calls_per_0_1_s(make_world, world02,
+                                                                  m2wr_urdf):
+    """In the open (row A 2 m to the side) a new command every 0.1 s: the drive's update that
+    applies it and the laser's scan one step later cut each 20 steps into 1 + 10 + 9 and
+    nothing more. The drive's next update, with the same command, would change nothing and
+    is run through (see the next test). The drive's schedule, which adds its period to its
+    last time, runs a few 1e-17 s ahead of the steps' times, and that rounding must not cost
+    a Bullet call of its own (it cost two in three of every ten commands)."""
     world = make_world(world02)
     robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(-1.0, 7.0, 0.1))
     drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
@@ -327,9 +328,52 @@ def test_a_20_hz_drive_and_laser_cost_four_bullet_calls_per_0_1_s(make_world, wo
         drive_part.set_command(*command)
         world.advance(CONTROL, collect=())
     assert calls.steps == 30 * CONTROL
-    assert calls.calls == 30 * 4
+    assert calls.calls == 30 * 3
 
 
+@pytest.mark.parametrize("variant", ["plain", "wheel acceleration", "command timeout"])
+def test_a_drive_update_that_changes_nothing_is_run_through_bit_for_bit(make_world, world02,
+                                                                       m2wr_urdf, variant):
+    """A wheel update that would give the wheels the motor commands they already have (the
+    same command, rims at its speeds, neither wheel held at zero) does not cut a stretch; its
+    schedule is kept as if it ran, so every later update comes at the same step. Held,
+    changed and zero commands, a wheelAcceleration ramp (updates that do change the wheels
+    until the ramp ends) and a command_timeout that stops the robot in the middle of a held
+    command: bit for bit what single steps give."""
+    urdf, timeout = m2wr_urdf, 0.0
+    if variant == "wheel acceleration":
+        urdf = m2wr_urdf.replace("<updateRate>20</updateRate>", "<updateRate>20</updateRate>"
+                                 "<wheelAcceleration>0.8</wheelAcceleration>")
+        assert urdf.count("wheelAcceleration") == 2
+    elif variant == "command timeout":
+        timeout = 0.03             # [s]: each command stops between two updates of its call
+    commands = [(0.4, 0.3)] * 6 + [(0.0, 0.0)] * 3 + [(0.4, -0.2)] * 5 + [(0.3, 0.0)] * 2
+    runs = {}
+    for batched in (False, True):
+        world = make_world(world02)
+        world.command_timeout = timeout
+        robot = world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(-1.0, 7.0, 0.1))
+        drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
+        assert drive_part.command_timeout == timeout
+        assert drive_part.wheel_acceleration == (0.8 if variant == "wheel acceleration" else 0)
+        calls = Calls(world)
+        marks = []
+
+        def between(index, calls=calls, marks=marks):
+            marks.append(calls.calls)
+        trace = drive(world, robot, commands, batched, between)
+        runs[batched] = trace, calls, marks
+    (single, single_events), _, _ = runs[False]
+    (trace, events), calls, marks = runs[True]
+    assert trace == single and events == single_events
+    moved = [state[2][0] for state, _, _ in trace]
+    assert math.dist(moved[5][:2], moved[0][:2]) > 0.05     # it drove
+    if variant == "plain":
+        # each call's first step brings a scan (collected), the drive's update at its middle
+        # is run through: 1 + 10 + 9; the zero commands hold the wheels (an update reads their
+        # angles) and keep 1 + 9 + 1 + 9
+        per_call = [b - a for a, b in zip(marks, marks[1:] + [calls.calls])]
+        assert per_call == [3] * 6 + [4] * 3 + [3] * 7
 def test_a_schedule_a_rounding_ahead_is_not_a_reset():
     """next_period_time: `last` above `now` by a rounding still promises the next period;
     by more (the sim time went back: a reset) it promises nothing."""
@@ -401,4 +445,4 @@ def test_touching_at_the_end_of_a_call_then_moved_away_batches_again(make_world,
     assert trace == single
     assert not any(touched for _, _, touched in trace[30:])
     assert marks["pressed"] > 20 * 5              # the last commands on the barrier: singles
-    assert calls.calls - marks["open"] == 8 * 4   # in the open: 9 + 1 + 9 + 1 per command
+    assert calls.calls - marks["open"] == 8 * 3   # in the open: 1 + 10 + 9 per command

@@ -51,7 +51,7 @@ import pybullet
 
 from . import wheel_contact
 from .parameters import ParameterReader
-from .part import Part, PartContext, next_period_time
+from .part import SCHEDULE_SLACK, Part, PartContext, next_period_time
 from .transforms import Pose, cross
 
 _TOLERANCE = 1e-9            # [s] slack for sim times accumulated in floating point
@@ -226,6 +226,8 @@ class DiffDrive(Part):
         self._command_time = None
         self._control.last = None
         self._publish.last = None
+        self._idle_update = None       # [s] the update next_activity_time let a batch skip
+        self._step = None              # [s] the physics step of the last before_step
         self._rim_speed = [0.0, 0.0]                       # [m/s] last applied, per wheel
         self._held = [None, None]                          # [rad] where a stopped wheel stays
         self._encoder = [0.0, 0.0, 0.0]                    # x [m], y [m], heading [rad]
@@ -236,6 +238,9 @@ class DiffDrive(Part):
     # --- stepping ---------------------------------------------------------------------------
     def before_step(self, sim_time, dt):
         """Called before each physics step at sim_time [s]; dt [s] is the step."""
+        self._step = dt
+        if self._idle_update is not None:
+            self._count_idle_update(sim_time - dt)
         if self._fresh:
             self._command_time = sim_time
             self._fresh = False
@@ -256,6 +261,37 @@ class DiffDrive(Part):
                 target = min(max(target, self._rim_speed[i] - step), self._rim_speed[i] + step)
             self._rim_speed[i] = target
         self._apply(self._rim_speed[0] / self.wheel_radius, self._rim_speed[1] / self.wheel_radius)
+
+    def after_step(self, sim_time):
+        """The end of a stretch of steps (see _count_idle_update)."""
+        if self._idle_update is not None:
+            self._count_idle_update(sim_time - self._step)
+
+    def _count_idle_update(self, last_step_start):
+        """Counts the update next_activity_time let a stretch of steps skip (it would have
+        changed nothing) if its step ran, that is if it was due by the start of the last
+        step run (`last_step_start` [s]): the schedule stays as if every step's before_step
+        had been called. Forgotten otherwise: next_activity_time says it anew."""
+        idle, self._idle_update = self._idle_update, None
+        if idle is not None and last_step_start >= idle - _TOLERANCE:
+            self._control.take(idle)
+
+    def _update_changes_nothing(self, sim_time):
+        """True when the wheel update due at sim_time [s] would give the wheels the motor
+        commands they already have: the same rim speeds as the last update (the command's
+        own, not ramped by wheelAcceleration, not stopped by command_timeout), neither of them
+        zero (a stopped wheel's hold reads its angle anew at each update). Bullet's motors
+        then stay as they are, to the bit, whether the update runs or not."""
+        v, w = self.command
+        if self.command_timeout > 0 and (self._command_time is None or
+                                         sim_time - self._command_time > self.command_timeout):
+            v, w = 0.0, 0.0
+        rims = self._rim_speed
+        radius = self.wheel_radius
+        for rim, speed in zip(rims, self.wheel_speeds(v, w)):
+            if speed * radius != rim or rim / radius == 0.0:
+                return False
+        return True
 
     def _apply(self, left, right):
         """Drive (leftJoint, rightJoint) at these speeds [rad/s], within their limits; a
@@ -341,6 +377,11 @@ class DiffDrive(Part):
             return now
         control = self._control
         soonest = next_period_time(control.last, control.period, now)
+        if soonest > now and self._update_changes_nothing(control.last + control.period):
+            # the next update would change nothing: a batch may run through it (after_step
+            # counts it), up to the one after, which the command given then may change
+            self._idle_update = control.last + control.period
+            soonest = self._idle_update + control.period - SCHEDULE_SLACK
         if self.publish_tf:
             publish = self._publish
             soonest = min(soonest, next_period_time(publish.last, publish.period, now))

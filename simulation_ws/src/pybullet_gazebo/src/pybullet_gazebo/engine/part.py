@@ -16,7 +16,11 @@ so the World calls them all and never probes a part for what it can do. Per phys
                            now < t < the answer do nothing and answer False, so the World may
                            run those steps in one Bullet call (World.advance). The default,
                            `now`, makes it step one step at a time: a part that does
-                           something every step (integrates, applies forces) keeps it.
+                           something every step (integrates, applies forces) keeps it. A
+                           hook call that would change nothing in Bullet may be left out of
+                           the promise, if the part keeps its own schedule as if the call
+                           had been made (after_step(now) ends every stretch; the diff
+                           drive's update with an unchanged command is one).
 
 and on demand:
 
