@@ -26,6 +26,6 @@ def rollout(seed):
 def test_batched_episodes_equal_step_by_step_ones(monkeypatch):
     batched = [rollout(seed) for seed in (3, 5)]
     assert any(step[-1] for trace in batched for step in trace[1:])    # some touched a model
-    monkeypatch.setattr(World, "_quiet_steps", lambda self, most, now: 1)
+    monkeypatch.setattr(World, "_quiet_steps", lambda self, most, now, skipped=None: (1, ()))
     single = [rollout(seed) for seed in (3, 5)]
     assert batched == single

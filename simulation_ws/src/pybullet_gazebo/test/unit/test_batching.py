@@ -311,14 +311,16 @@ def test_safe_time_shrinks_near_an_obstacle(make_world, world02, m2wr_urdf):
     assert world._batcher.safe_time(robots, others, grounds, 0.1) < 2 * STEP
 
 
-def test_a_20_hz_drive_and_laser_cost_three_bullet_calls_per_0_1_s(make_world, world02,
-                                                                  m2wr_urdf):
-    """In the open (row A 2 m to the side) a new command every 0.1 s: the drive's update that
-    applies it and the laser's scan one step later cut each 20 steps into 1 + 10 + 9 and
-    nothing more. The drive's next update, with the same command, would change nothing and
-    is run through (see the next test). The drive's schedule, which adds its period to its
-    last time, runs a few 1e-17 s ahead of the steps' times, and that rounding must not cost
-    a Bullet call of its own (it cost two in three of every ten commands)."""
+@pytest.mark.parametrize("collect, calls_per_command", [(True, 3), ((), 1)])
+def test_a_20_hz_drive_and_laser_cost_few_bullet_calls_per_0_1_s(make_world, world02, m2wr_urdf,
+                                                                collect, calls_per_command):
+    """In the open (row A 2 m to the side) a new command every 0.1 s. Collecting every
+    reading, the scan and odometry one step after the drive's update cut each 20 steps into
+    1 + 10 + 9; the drive's next update, with the same command, would change nothing and is
+    run through (see the next test). Collecting none, the readings are skipped inside one
+    call of 20 steps. The drive's schedule, which adds its period to its last time, runs a
+    few 1e-17 s ahead of the steps' times, and that rounding must not cost a Bullet call of
+    its own (it cost two in three of every ten commands)."""
     world = make_world(world02)
     robot = world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(-1.0, 7.0, 0.1))
     drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
@@ -326,9 +328,45 @@ def test_a_20_hz_drive_and_laser_cost_three_bullet_calls_per_0_1_s(make_world, w
     calls = Calls(world)
     for command in [(0.2, 0.0), (0.3, 0.1), (0.2, -0.1)] * 10:
         drive_part.set_command(*command)
-        world.advance(CONTROL, collect=())
+        world.advance(CONTROL, collect=collect)
     assert calls.steps == 30 * CONTROL
-    assert calls.calls == 30 * 3
+    assert calls.calls == 30 * calls_per_command
+
+
+def test_readings_skipped_inside_a_stretch_are_those_single_steps_skip(make_world, world02,
+                                                                      m2wr_urdf):
+    """Two robots whose noisy lasers draw from the world's one noise stream, readings
+    collected from neither, from one laser after a given step, or from all: the same scans
+    and odometry, to the bit (noise included: the skipped scans drew theirs in the same
+    order), and the same states as single steps; with fewer Bullet calls."""
+    from pybullet_gazebo.engine.ray_sensor import RaySensor
+    plan = [((), 0), ("a", 7), ((), 0), ("a", 0), ("b", 13), (True, 0), ("a", 19), ((), 0)] * 2
+    runs = []
+    for batched in (False, True):
+        world = make_world(world02)
+        robots = [world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(-1.0, 7.0, 0.1)),
+                  world.spawn_urdf("m2wr_b", m2wr_urdf, Pose.from_xyz_rpy(-1.0, -7.0, 0.1))]
+        lasers = {"a": robots[0].parts_with(RaySensor.KEY)[0],
+                  "b": robots[1].parts_with(RaySensor.KEY)[0]}
+        assert lasers["a"].rng is lasers["b"].rng and lasers["a"]._noisy
+        drives = [next(p for p in r.parts if isinstance(p, DiffDrive)) for r in robots]
+        calls = Calls(world)
+        out = []
+        for index, (which, first) in enumerate(plan):
+            drives[0].set_command(0.3, 0.4 if index % 3 else -0.4)
+            drives[1].set_command(0.2, 0.0)
+            collect = which if which in ((), True) else (lasers[which],)
+            if batched:
+                readings = world.advance(CONTROL, collect=collect, collect_from=first)
+            else:
+                readings = []
+                for step in range(CONTROL):
+                    readings += world.step(collect=collect if step >= first else ())
+            out.append(readings_record(readings))
+        runs.append((out, [state(world, r) for r in robots], calls.calls))
+    assert runs[0][:2] == runs[1][:2]
+    assert sum(len(record) for record in runs[1][0]) > len(plan)
+    assert runs[1][2] < runs[0][2] / 4
 
 
 @pytest.mark.parametrize("variant", ["plain", "wheel acceleration", "command timeout"])

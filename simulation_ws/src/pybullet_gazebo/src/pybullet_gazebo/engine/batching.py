@@ -4,8 +4,9 @@
 Bullet's stepSimulation with fixedTimeStep = k dt and numSubSteps = k runs k internal steps
 of dt: the same arithmetic as k calls with dt, provided nothing happens between the steps.
 What may not happen in between, and how each is ruled out:
-- a part's hook acting: the World batches only steps before every part's
-  next_activity_time (Part contract);
+- a part's hook acting: the World batches only steps before every part's next_hook_time
+  and, for readings that are collected, next_reading_time (Part contract; the readings
+  nobody collects are skipped after the call, at their own times);
 - a force or joint effort of the wrench schedule (applied per call, not per internal step):
   no batch while it holds any job or weightless link;
 - joint damping: pybullet adds it once per call, from the joint speeds at the call (a

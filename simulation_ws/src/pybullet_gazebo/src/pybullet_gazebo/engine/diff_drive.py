@@ -226,7 +226,7 @@ class DiffDrive(Part):
         self._command_time = None
         self._control.last = None
         self._publish.last = None
-        self._idle_update = None       # [s] the update next_activity_time let a batch skip
+        self._idle_update = None       # [s] the update next_hook_time let a batch skip
         self._step = None              # [s] the physics step of the last before_step
         self._rim_speed = [0.0, 0.0]                       # [m/s] last applied, per wheel
         self._held = [None, None]                          # [rad] where a stopped wheel stays
@@ -268,10 +268,10 @@ class DiffDrive(Part):
             self._count_idle_update(sim_time - self._step)
 
     def _count_idle_update(self, last_step_start):
-        """Counts the update next_activity_time let a stretch of steps skip (it would have
+        """Counts the update next_hook_time let a stretch of steps skip (it would have
         changed nothing) if its step ran, that is if it was due by the start of the last
         step run (`last_step_start` [s]): the schedule stays as if every step's before_step
-        had been called. Forgotten otherwise: next_activity_time says it anew."""
+        had been called. Forgotten otherwise: next_hook_time says it anew."""
         idle, self._idle_update = self._idle_update, None
         if idle is not None and last_step_start >= idle - _TOLERANCE:
             self._control.take(idle)
@@ -369,9 +369,9 @@ class DiffDrive(Part):
     def skip(self, now):
         pass                    # due() already advanced the schedule; no noise
 
-    def next_activity_time(self, now):
-        """The next wheel update or odometry (see Part); every step with encoder odometry,
-        which integrates the wheel speeds each step, or while a new command waits to be
+    def next_hook_time(self, now):
+        """The next wheel update (see Part); every step with encoder odometry, which
+        integrates the wheel speeds each step, or while a new command waits to be
         time-stamped (the next before_step does it)."""
         if self.odometry_source == "encoder" or self._fresh:
             return now
@@ -382,10 +382,13 @@ class DiffDrive(Part):
             # counts it), up to the one after, which the command given then may change
             self._idle_update = control.last + control.period
             soonest = self._idle_update + control.period - SCHEDULE_SLACK
-        if self.publish_tf:
-            publish = self._publish
-            soonest = min(soonest, next_period_time(publish.last, publish.period, now))
         return soonest
+
+    def next_reading_time(self, now):
+        """The next odometry (see Part); never when publishTf is false."""
+        if not self.publish_tf:
+            return math.inf
+        return next_period_time(self._publish.last, self._publish.period, now)
 
     def odometry(self):
         """Odometry of the base link now (see the module docstring)."""

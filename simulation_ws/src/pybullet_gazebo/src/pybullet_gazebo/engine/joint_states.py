@@ -11,6 +11,7 @@ plugin of its own, whatever publishWheelJointState says, so that rviz can place 
 wheels (Gazebo publishes them only when the description asks; the tutorial's does not).
 """
 from dataclasses import dataclass
+import math
 from typing import List, Tuple
 
 from .parameters import ParameterReader
@@ -71,7 +72,10 @@ class JointStatePublisher(Part):
     def skip(self, now):
         pass                    # due() already advanced the schedule; no noise
 
-    def next_activity_time(self, now):
+    def next_hook_time(self, now):
+        return math.inf                 # no hooks
+
+    def next_reading_time(self, now):
         return next_period_time(self._last, self.period, now)
 
     def reset(self):

@@ -11,16 +11,23 @@ so the World calls them all and never probes a part for what it can do. Per phys
     skip(now)              instead of measure(now) when nobody reads it (World.step with
                            collect=False): the part's schedule and noise stream advance
                            exactly as if it had measured (default: measure, result dropped)
-    next_activity_time(now) -> float   [s] asked after before_step(now): the part promises
-                           that before_step, after_step and due at every sim time t with
-                           now < t < the answer do nothing and answer False, so the World may
-                           run those steps in one Bullet call (World.advance). The default,
-                           `now`, makes it step one step at a time: a part that does
-                           something every step (integrates, applies forces) keeps it. A
-                           hook call that would change nothing in Bullet may be left out of
-                           the promise, if the part keeps its own schedule as if the call
-                           had been made (after_step(now) ends every stretch; the diff
-                           drive's update with an unchanged command is one).
+    next_hook_time(now) -> float   [s] asked after before_step(now): the part promises that
+                           before_step and after_step at every sim time t with
+                           now < t < the answer do nothing, so the World may run those steps
+                           in one Bullet call (World.advance). The default, `now`, makes it
+                           step one step at a time: a part that does something every step
+                           (integrates, applies forces) keeps it. A hook call that would
+                           change nothing in Bullet may be left out of the promise, if the
+                           part keeps its own schedule as if the call had been made
+                           (after_step(now) ends every stretch; the diff drive's update with
+                           an unchanged command is one).
+    next_reading_time(now) -> float   [s] the same promise for due(t): False for every
+                           now < t < the answer (default `now`). A reading nobody collects
+                           (skip) may then fall inside a stretch: after it, the World calls
+                           due(t) and skip(t) at the sim times t inside the stretch from the
+                           answer on, in step order, as single steps would have. So skip must
+                           not touch Bullet, and due and skip must not need after_step first.
+    next_activity_time(now)  the earlier of the two (not overridden)
 
 and on demand:
 
@@ -102,8 +109,14 @@ class Part:
     def skip(self, now: float) -> None:
         self.measure(now)
 
-    def next_activity_time(self, now: float) -> float:
+    def next_hook_time(self, now: float) -> float:
         return now
+
+    def next_reading_time(self, now: float) -> float:
+        return now
+
+    def next_activity_time(self, now: float) -> float:
+        return min(self.next_hook_time(now), self.next_reading_time(now))
 
     def reset(self) -> None:
         pass

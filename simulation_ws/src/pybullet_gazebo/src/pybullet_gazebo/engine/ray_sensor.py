@@ -17,6 +17,7 @@ The ROS adapter publishes `measure()`'s LaserScanData on
 `update_rate` [Hz] of sim time (0 = every step).
 """
 from dataclasses import dataclass
+import math
 
 import numpy as np
 
@@ -129,7 +130,10 @@ class RaySensor(Part):
         the first call, and when the sim time went backwards)."""
         return _due(self._last, sim_time, self._period)
 
-    def next_activity_time(self, now):
+    def next_hook_time(self, now):
+        return math.inf                 # no hooks: a scan is a reading
+
+    def next_reading_time(self, now):
         """The next scan (see Part)."""
         return next_period_time(self._last, self._period, now)
 

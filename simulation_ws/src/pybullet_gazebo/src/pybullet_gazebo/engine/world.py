@@ -149,7 +149,8 @@ class World:
         models (a caller that publishes those at once, as the ROS loop does; step_count says
         how many steps ran). `collect_from`: the readings due in the steps before this one
         (0: the first) are skipped whatever `collect` says (a caller that observes only the
-        last of them)."""
+        last of them). A reading that is skipped does not end a stretch (see
+        Part.next_reading_time), except with until_news."""
         if self._robots is None:
             self.robots()                   # refreshes the caches after a spawn or delete
         parts = self._stepped[0]
@@ -158,12 +159,21 @@ class World:
         skipped_until = self.step_count + collect_from   # step count after the last skipped
         self._safe_until = self._single_until = -1     # the guard's answers hold for one call
         changes = self.contacts.changes if until_news else None
+        # the readings skipped whatever their time: those of parts not collected, and those
+        # due up to step count skipped_until (None: none is, or readings end stretches)
+        skipping = collect is not True and changes is None
+        skippers = ()
         while left > 0:
             now = self.sim_time
             for _, part in parts:
                 part.before_step(now, self.step_size)
             self.wrenches.apply(now)
-            k = self._quiet_steps(left, now) if left > 1 else 1
+            if left > 1:
+                k, skippers = self._quiet_steps(
+                    left, now, (collect, skipped_until) if skipping else None)
+            else:
+                k = 1
+            start = self.step_count
             if k == 1 and self.step_count + 1 < self._single_until:
                 # a quiet stretch the contact guard would not batch: its steps one by one,
                 # contacts read after each, without the parts' hooks (idle until its end)
@@ -178,6 +188,8 @@ class World:
             else:
                 self._batcher.step(self.step_size, k)
                 self.step_count += k
+            if k > 1 and skippers:
+                self._skip_readings_inside(skippers, start, k)
             left -= k
             now = self.sim_time
             for robot, part in parts:
@@ -220,18 +232,55 @@ class World:
             touched.update(pairs)
         return True
 
-    def _quiet_steps(self, most, now):
-        """How many of the next `most` steps, the first of which starts now (its before_step
-        hooks done), may run as one Bullet call (see batching.py)."""
+    def _skip_readings_inside(self, skippers, start, k):
+        """Skips the readings of `skippers` (parts) due at the k - 1 sim times inside the
+        stretch of k steps that began at step count `start`, as single steps would have:
+        in step order, and at each time in the parts' order."""
+        size, before, time_before = self.step_size, self._steps_before, self._time_before
+        due_at = [part.next_reading_time(time_before + (start - before) * size)
+                  for part in skippers]
+        first = min(due_at)
+        for count in range(start + 1, start + k):
+            now = time_before + (count - before) * size      # as sim_time reads it
+            if now < first:
+                continue
+            for index, part in enumerate(skippers):
+                if now >= due_at[index] and part.due(now):
+                    part.skip(now)
+                    due_at[index] = part.next_reading_time(now)
+            first = min(due_at)
+
+    def _quiet_steps(self, most, now, skipped=None):
+        """(k, skippers): how many of the next `most` steps, the first of which starts now
+        (its before_step hooks done), may run as one Bullet call (see batching.py), and the
+        parts whose readings due inside them are to be skipped after. `skipped`:
+        (collect, skipped_until) as advance has them, when readings nobody collects may fall
+        inside a stretch; None: every reading ends one."""
         if self.step_count < self._single_until:
-            return 1                        # the contact guard said no for this stretch
+            return 1, ()                    # the contact guard said no for this stretch
         if self._settled != self.layout_version or not self.wrenches.idle():
-            return 1                        # a teleport, spawn or delete: one step first
+            return 1, ()                    # a teleport, spawn or delete: one step first
         quiet = math.inf
-        for _, part in self._stepped[0]:
-            quiet = min(quiet, part.next_activity_time(now))
-        # k steps may run when the k - 1 sim times between them come before `quiet`
         k = min(most, MAX_BATCH)
+        skippers = []
+        if skipped is None:
+            for _, part in self._stepped[0]:
+                quiet = min(quiet, part.next_activity_time(now))
+        else:
+            collect, skipped_until = skipped
+            for _, part in self._stepped[0]:
+                if part not in collect:
+                    skippers.append(part)
+                    quiet = min(quiet, part.next_hook_time(now))
+                elif self.step_count < skipped_until:
+                    # skipped up to step count skipped_until, collected after it: the
+                    # stretch may hold those skipped, and end on the first collected one
+                    skippers.append(part)
+                    quiet = min(quiet, part.next_hook_time(now))
+                    k = min(k, skipped_until - self.step_count + 1)
+                else:
+                    quiet = min(quiet, part.next_activity_time(now))
+        # k steps may run when the k - 1 sim times between them come before `quiet`
         if quiet < math.inf:
             k = min(k, max(1, int((quiet - now) / self.step_size) + 2))
         while k > 1 and not self.time_after(k - 1) < quiet:
@@ -249,8 +298,8 @@ class World:
                 self.step_size, min(k, self._safe_until - self.step_count))
             if k < 2:
                 self._single_until = self.step_count + wanted
-                return 1
-        return k
+                return 1, skippers
+        return k, skippers
 
     def next_command_time(self):
         """Earliest sim time [s] at which a part next reads its command (None: no part takes
