@@ -100,7 +100,7 @@ class InProcessSim:
         go on as if made)."""
         self._drive.set_command(linear_x, angular_z)
         world = self.world
-        scans = self._laser.scans_at([world.time_after(k) for k in range(1, steps + 1)])
+        scans = self._laser.scans_at(world.times_after(steps))
         touched = set()
         if scans:                                      # cast at the last, skip those before
             readings = world.advance(steps, collect=(self._laser,), touched=touched,

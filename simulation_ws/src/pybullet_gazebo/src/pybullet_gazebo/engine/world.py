@@ -131,6 +131,11 @@ class World:
         then read, to the last bit)."""
         return self._time_before + (self.step_count + steps - self._steps_before) * self.step_size
 
+    def times_after(self, steps: int) -> List[float]:
+        """[time_after(1), ..., time_after(steps)], to the last bit."""
+        base, done, size = self._time_before, self.step_count - self._steps_before, self.step_size
+        return [base + (done + k) * size for k in range(1, steps + 1)]
+
     def step(self, collect=True) -> List[Reading]:
         """Advances physics by one fixed step; returns the parts' readings now due. `collect`:
         True = every part's, or a collection of the parts whose readings are wanted (empty:
