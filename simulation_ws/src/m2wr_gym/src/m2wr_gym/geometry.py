@@ -127,9 +127,11 @@ class Footprints:
         """A pose (x, y, yaw) drawn uniformly inside the obstacles' bounding box (shrunk by
         `margin`) whose robot circle is at least `margin` [m] from every footprint."""
         low, high = self.bounds[0] + margin, self.bounds[1] - margin
+        needed = ROBOT_RADIUS + margin
         for _ in range(attempts):
             x, y = rng.uniform(low, high)
-            if self.distance([(x, y)])[0] >= ROBOT_RADIUS + margin:
+            # footprints farther than `needed` cannot refuse the pose: left out
+            if self.distance([(x, y)], within=needed)[0] >= needed:
                 return float(x), float(y), float(rng.uniform(-math.pi, math.pi))
         raise RuntimeError("no free start pose found in %d draws; the world is too full "
                            "for a random start: pass start=[(x, y, yaw), ...]" % attempts)
