@@ -1,11 +1,11 @@
 """Speed figures of the environments (printed, never asserted): `python -m m2wr_gym.bench`.
 
 1. One in-process environment (world02, 10 Hz control, 720-beam scan, random continuous
-   actions drawn before the timing, episodes of 120 s from random free starts, resets
-   included) against bare Bullet: the same world and m2wr built by the same World, driven
-   by a constant command, stepped with client.stepSimulation() alone (no laser, no drive
-   updates, no contacts). Both as sim seconds per wall second; the ratio is the
-   environment's share of Bullet's speed.
+   actions drawn before the timing, the same three episodes from random free starts in
+   every round, see env_against_bare) against bare Bullet: the same world and m2wr built
+   by the same World, driven by a constant command, stepped with client.stepSimulation()
+   alone (no laser, no drive updates, no contacts), in turns with the environment. Both as
+   sim seconds per wall second; the ratio is the environment's share of Bullet's speed.
 2. Vectorised (--part vector): the same two episodes (seeds s and s + 1, random free starts,
    actions drawn ahead, so no sampler runs in the timed loops) stepped in this process one
    after the other, in one subprocess (an AsyncVectorEnv of one), in two subprocesses at
@@ -18,10 +18,10 @@
 3. Where one in-process control step's CPU time goes, timed inside the env's own steps (see
    breakdown()): Bullet's physics, the contact guard and reads, the one scan observed, the
    rest of the engine, the environment's own Python.
-Measurements alternate in rounds (--rounds); for 1 and 3 the best round of each is kept, so a
-busy moment of a shared machine hits both sides alike (1 also as the median of the
-same-round ratios); for 2 the median of the same-round
-ratios (with their range). The in-process figures are also given per
+Measurements alternate in rounds (--rounds); for 1 the median of the rounds' ratios (with
+their range), each round's two sides taken in turns piece by piece, so a busy moment of a
+shared machine hits both alike; for 3 the round with the least CPU; for 2 the median of the
+same-round ratios (with their range). The in-process figures are also given per
 second of this process's CPU time, which other programs on a shared machine disturb less
 than wall time (but still: note the load, `uptime`, with any figure).
 """
@@ -113,6 +113,56 @@ def drawn_actions(env, steps, seed):
     (gymnasium's Box.sample, ~25 us) is the learner's work, not the environment's."""
     env.action_space.seed(seed)
     return [env.action_space.sample() for _ in range(steps)]
+
+
+EPISODES = (0, 1, 2)    # the seeds of the episodes every round of the in-process figure runs
+CHUNKS = 2              # pieces of each episode, each followed by bare Bullet's turn
+
+
+def env_against_bare(steps):
+    """One round of the in-process figure: the same episodes every round (seeds EPISODES,
+    random free starts, steps / len(EPISODES) random actions each, drawn ahead; the reset
+    before each is not timed) in CHUNKS pieces each, every piece followed by bare Bullet
+    stepping as much sim time (bare_bullet's world and command), so both sides meet the
+    same moments of a shared machine. Returns (env sim s per wall s, env steps per wall s,
+    env sim s per CPU s, bare sim s per wall s, bare sim s per CPU s)."""
+    bare_env = make().unwrapped
+    bare_env.reset(seed=0)
+    sim = bare_env.sim
+    sim._drive.set_command(0.3, 0.2)
+    sim.world.step()                      # the drive applies the command once
+    bare_step = sim.client.stepSimulation
+    clock, cpu = time.perf_counter, time.process_time
+    env_wall = env_cpu = bare_wall = bare_cpu = 0.0
+    env_steps = bare_steps = 0
+    per_episode = max(CHUNKS, steps // len(EPISODES))
+    dt = None
+    for seed in EPISODES:
+        env = make()
+        dt = env.unwrapped.dt
+        ahead = drawn_actions(env, per_episode, seed)
+        env.reset(seed=seed)
+        for piece in np.array_split(np.arange(per_episode), CHUNKS):
+            started, cpu_started = clock(), cpu()
+            for index in piece:
+                _, _, terminated, truncated, _ = env.step(ahead[index])
+                if terminated or truncated:
+                    env.reset()
+            env_wall += clock() - started
+            env_cpu += cpu() - cpu_started
+            env_steps += len(piece)
+            physics = int(round(len(piece) * dt / sim.physics_step))
+            started, cpu_started = clock(), cpu()
+            for _ in range(physics):
+                bare_step()
+            bare_wall += clock() - started
+            bare_cpu += cpu() - cpu_started
+            bare_steps += physics
+        env.close()
+    bare_env.close()
+    env_sim, bare_sim = env_steps * dt, bare_steps * sim.physics_step
+    return (env_sim / env_wall, env_steps / env_wall, env_sim / env_cpu,
+            bare_sim / bare_wall, bare_sim / bare_cpu)
 
 
 def one_env(steps, seed=0):
@@ -404,14 +454,13 @@ def main(argv=None):
     vector_rounds = []
     for r in range(args.rounds):
         if args.part != "vector":
-            rate, cpu_rate = bare_bullet(args.steps * 0.1)
-            bare.append(rate)
-            bare_cpu.append(cpu_rate)
-            rate, per_s, cpu_rate = one_env(args.steps, seed=r)
+            rate, per_s, cpu_rate, bare_rate, bare_cpu_rate = env_against_bare(args.steps)
+            bare.append(bare_rate)
+            bare_cpu.append(bare_cpu_rate)
             env_rate.append(rate)
             env_steps.append(per_s)
             env_cpu.append(cpu_rate)
-            parts_by_round.append(breakdown(args.steps // 2, seed=r))
+            parts_by_round.append(breakdown(args.steps // 2, seed=0))
             print("[bench] round %d/%d: bare Bullet %.0fx real time, env %.0fx (%.0f steps/s)"
                   % (r + 1, args.rounds, bare[-1], env_rate[-1], env_steps[-1]), flush=True)
         if args.part != "env":
@@ -427,17 +476,19 @@ def main(argv=None):
 
 
 def print_env_summary(args, bare, env_rate, env_steps, bare_cpu, env_cpu, parts_by_round):
-    print("\nbest of %d rounds, %d env steps each (world02, 10 Hz, 720 beams, random actions):"
-          % (args.rounds, args.steps))
-    print("  bare Bullet stepping (same world + m2wr):  %6.0f sim s / wall s" % max(bare))
-    print("  one environment in process:              %6.0f sim s / wall s  (%.0f env steps/s)"
-          % (max(env_rate), max(env_steps)))
-    print("  environment / bare Bullet:               %6.2f" % (max(env_rate) / max(bare)))
-    print("  per CPU second: bare Bullet %.0f, environment %.0f sim s; ratio %.2f"
-          % (max(bare_cpu), max(env_cpu), max(env_cpu) / max(bare_cpu)))
     ratios = sorted(e / b for e, b in zip(env_rate, bare))
-    print("  the same, round by round: median %.2f (range %.2f-%.2f)"
+    cpu_ratios = sorted(e / b for e, b in zip(env_cpu, bare_cpu))
+    print("\n%d rounds of the same %d episodes, %d env steps in all (world02, 10 Hz, 720 beams, "
+          "random actions), each piece of env followed by as much sim time of bare Bullet:"
+          % (args.rounds, len(EPISODES), len(EPISODES) * max(CHUNKS, args.steps // len(EPISODES))))
+    print("  bare Bullet stepping (same world + m2wr):  %6.0f sim s / wall s (median of rounds)"
+          % float(np.median(bare)))
+    print("  one environment in process:              %6.0f sim s / wall s  (%.0f env steps/s)"
+          % (float(np.median(env_rate)), float(np.median(env_steps))))
+    print("  environment / bare Bullet, round by round: median %.2f (range %.2f-%.2f)"
           % (float(np.median(ratios)), ratios[0], ratios[-1]))
+    print("  the same per CPU second:                   median %.2f (range %.2f-%.2f)"
+          % (float(np.median(cpu_ratios)), cpu_ratios[0], cpu_ratios[-1]))
     parts = min(parts_by_round, key=lambda parts: parts["env step"])
     print("  CPU per env step in process [us] (round with the least): %.0f = Bullet's physics "
           "%.0f (%.1f calls) + contact guard %.0f + contact reads %.0f + one scan %.0f + rest "
