@@ -153,7 +153,7 @@ class RaySensor(Part):
         and the noise stream advance exactly as measure() would advance them."""
         if self._noisy:
             # measure() takes one standard normal draw per beam, as this does
-            self.rng.standard_normal(len(self._cos_sin))
+            self.rng.standard_normal(out=self._normals)
         self._last = sim_time
 
     def _link_frame(self):

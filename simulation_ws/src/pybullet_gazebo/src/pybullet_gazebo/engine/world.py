@@ -167,14 +167,14 @@ class World:
         # the readings skipped whatever their time: those of parts not collected, and those
         # due up to step count skipped_until (None: none is, or readings end stretches)
         skipping = collect is not True and changes is None
-        skippers = ()
+        inside = ()                     # readings to skip after the next stretch
         while left > 0:
             now = self.sim_time
             for _, part in parts:
                 part.before_step(now, self.step_size)
             self.wrenches.apply(now)
             if left > 1:
-                k, skippers = self._quiet_steps(
+                k, inside = self._quiet_steps(
                     left, now, (collect, skipped_until) if skipping else None)
             else:
                 k = 1
@@ -193,8 +193,8 @@ class World:
             else:
                 self._batcher.step(self.step_size, k)
                 self.step_count += k
-            if k > 1 and skippers:
-                self._skip_readings_inside(skippers, start, k)
+            if k > 1 and inside:
+                self._skip_readings_inside(inside, start, k)
             left -= k
             now = self.sim_time
             for robot, part in parts:
@@ -237,13 +237,26 @@ class World:
             touched.update(pairs)
         return True
 
-    def _skip_readings_inside(self, skippers, start, k):
-        """Skips the readings of `skippers` (parts) due at the k - 1 sim times inside the
-        stretch of k steps that began at step count `start`, as single steps would have:
-        in step order, and at each time in the parts' order."""
+    def _readings_inside(self, skippers, now, steps):
+        """[(part, its next_reading_time)] of the `skippers` whose next reading may fall
+        inside a stretch of `steps` steps from now (at one of its k - 1 inner sim times)."""
+        if steps < 2:
+            return ()
+        last = self.time_after(steps - 1)
+        inside = []
+        for part in skippers:
+            due = part.next_reading_time(now)
+            if due <= last:
+                inside.append((part, due))
+        return inside
+
+    def _skip_readings_inside(self, inside, start, k):
+        """Skips the readings due at the k - 1 sim times inside the stretch of k steps that
+        began at step count `start`, as single steps would have: in step order, and at
+        each time in the parts' order. `inside`: _readings_inside's answer for it."""
         size, before, time_before = self.step_size, self._steps_before, self._time_before
-        due_at = [part.next_reading_time(time_before + (start - before) * size)
-                  for part in skippers]
+        skippers = [part for part, _ in inside]
+        due_at = [due for _, due in inside]
         first = min(due_at)
         for count in range(start + 1, start + k):
             now = time_before + (count - before) * size      # as sim_time reads it
@@ -256,9 +269,9 @@ class World:
             first = min(due_at)
 
     def _quiet_steps(self, most, now, skipped=None):
-        """(k, skippers): how many of the next `most` steps, the first of which starts now
+        """(k, inside): how many of the next `most` steps, the first of which starts now
         (its before_step hooks done), may run as one Bullet call (see batching.py), and the
-        parts whose readings due inside them are to be skipped after. `skipped`:
+        readings due inside them to be skipped after (see _readings_inside). `skipped`:
         (collect, skipped_until) as advance has them, when readings nobody collects may fall
         inside a stretch; None: every reading ends one."""
         if self.step_count < self._single_until:
@@ -303,8 +316,8 @@ class World:
                 self.step_size, min(k, self._safe_until - self.step_count))
             if k < 2:
                 self._single_until = self.step_count + wanted
-                return 1, skippers
-        return k, skippers
+                return 1, skippers and self._readings_inside(skippers, now, wanted)
+        return k, skippers and self._readings_inside(skippers, now, k)
 
     def next_command_time(self):
         """Earliest sim time [s] at which a part next reads its command (None: no part takes
