@@ -39,6 +39,7 @@ from gymnasium.vector import AsyncVectorEnv
 from m2wr_tools.processes import cpu_seconds
 
 from . import actions
+from .shared_vector import SharedMemoryVectorEnv
 
 KWARGS = dict(world="world02", start="random", observation="scan", action="continuous",
               control_rate=10.0, max_episode_seconds=120.0, end_on_contact=False)
@@ -281,7 +282,7 @@ def in_process(work):
     return {"rate": timed / wall, "cpu": cpu / timed}
 
 
-def in_subprocesses(work, parallel, library="gymnasium"):
+def in_subprocesses(work, parallel, library="gymnasium", **options):
     """The stretches in subprocesses, as a learner runs them: `parallel` = 1 (one
     AsyncVectorEnv of one env, stretch after stretch) or 2 (both at once, one env per
     worker); library "sb3": stable-baselines3's SubprocVecEnv instead (its default start
@@ -296,6 +297,8 @@ def in_subprocesses(work, parallel, library="gymnasium"):
             if library == "sb3":
                 from stable_baselines3.common.vec_env import SubprocVecEnv
                 vector = SubprocVecEnv([make] * parallel)
+            elif library == "shm":
+                vector = SharedMemoryVectorEnv([make] * parallel, **options)
             else:
                 vector = AsyncVectorEnv([make] * parallel)
         pids = [process.pid for process in vector.processes]

@@ -1,0 +1,649 @@
+"""SharedMemoryVectorEnv: a gymnasium VectorEnv running one environment per worker process,
+with the per-step traffic in shared memory instead of pipes.
+
+    from m2wr_gym.shared_vector import SharedMemoryVectorEnv
+    envs = SharedMemoryVectorEnv([lambda: gymnasium.make("m2wr_gym:M2wrAvoid-v0")] * 2)
+    observations, infos = envs.reset(seed=0)          # seeds 0 and 1, as AsyncVectorEnv
+    observations, rewards, terminations, truncations, infos = envs.step(actions)
+    envs.close()
+
+What a step returns is what gymnasium's AsyncVectorEnv returns for the same environments,
+seeds and actions (observations, rewards, flags and the merged infos with their "_key"
+masks), autoreset included (NEXT_STEP by default, as AsyncVectorEnv; SAME_STEP and DISABLED
+on request; metadata["autoreset_mode"] says which). The difference is the way there:
+
+- Actions, observations, rewards and the terminated/truncated flags live in shared arrays;
+  the numeric entries of each info (float, int, bool, numpy scalars, tuples of floats, such
+  as m2wr's sim_time, x, y, yaw, nearest, distance, command) in shared slots. A step is: the
+  learner writes the actions and posts each worker's "go" semaphore, each worker steps and
+  posts its "done" semaphore. No pickling and no pipe on that path.
+- Each worker also has a pipe, used only when something is rare: reset (seeds, options),
+  call / get_attr / set_attr, close, and from the worker: an info whose keys or kinds
+  changed, info values that do not fit a slot (touched model names, final_obs/final_info
+  at an episode's end in SAME_STEP mode, nested dicts), and errors.
+- An exception in a sub-environment's reset or step is caught in its worker, which keeps the
+  environment; the learner raises SubEnvironmentError naming the sub-environment, its
+  worker's PID, the call and its input, with the original exception as __cause__. The other
+  sub-environments have stepped: their results are in the error's `.result`, and the next
+  step goes on from there (the failed one's environment is as the failed call left it).
+- A worker that dies (killed, crashed) is noticed while waiting (liveness checked every
+  0.2 s): WorkerDiedError names it; the vector env is then broken, close() still works.
+- close() asks every worker to close its environment and exit, joins it by PID (5 s), then
+  terminates (and kills) what is left. Workers block SIGINT from their first instruction,
+  so a Ctrl-C reaches the learner alone, which closes them.
+- Workers wait for "go" spinning for `spin` seconds (non-blocking tries of the semaphore,
+  yielding the core to any other runnable thread) before they block on it; `pin=True`
+  pins worker i to the i-th core this process may use (the learner floats).
+"""
+import ctypes
+import multiprocessing
+import os
+import signal
+import sys
+import time
+import traceback
+
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import CloudpickleWrapper, batch_space
+
+__all__ = ["SharedMemoryVectorEnv", "SubEnvironmentError", "WorkerDiedError"]
+
+MAX_SLOTS = 32           # numeric info slots per worker; more go through the pipe
+LIVENESS = 0.2           # [s] between checks that a waited-for worker is still alive
+CLOSE_JOIN = 5.0         # [s] a worker is given to exit after "close" before terminate
+
+# command (learner -> worker), in shared memory
+STEP, MESSAGE = 0, 1
+# status (worker -> learner), in shared memory: the step's results are all in the shared
+# arrays, or a pipe message follows
+PLAIN, FOLLOWS = 0, 1
+
+
+class SubEnvironmentError(RuntimeError):
+    """A sub-environment raised in its worker; the worker and its environment go on.
+    index, pid, call ("step" or "reset"), given (repr of the action or arguments),
+    error_type (the original exception's class name), remote_traceback, result (the
+    step's return with the failed sub-environments masked out: observation as before,
+    reward 0, flags False, no info)."""
+
+    def __init__(self, message, index, pid, call, given, error_type, remote_traceback):
+        super().__init__(message)
+        self.index, self.pid, self.call, self.given = index, pid, call, given
+        self.error_type, self.remote_traceback = error_type, remote_traceback
+        self.result = None
+
+
+class WorkerDiedError(RuntimeError):
+    """A worker process ended while it was expected to answer."""
+
+
+class _RemoteError(Exception):
+    """Stands for an exception that could not be pickled back from a worker."""
+
+
+def _shared_array(ctx, dtype, shape):
+    dtype = np.dtype(dtype)
+    size = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
+    return (ctx.RawArray(ctypes.c_uint8, max(size, 1)), dtype.str, tuple(shape))
+
+
+def _view(shared):
+    raw, dtype, shape = shared
+    count = int(np.prod(shape, dtype=np.int64))
+    return np.frombuffer(raw, dtype=np.dtype(dtype), count=count).reshape(shape)
+
+
+def _fixed_shape_space(space, what):
+    if not isinstance(space, (spaces.Box, spaces.Discrete, spaces.MultiDiscrete,
+                              spaces.MultiBinary)):
+        raise ValueError("SharedMemoryVectorEnv needs a Box, Discrete, MultiDiscrete or "
+                         "MultiBinary %s space (fixed shape and dtype); got %r: use "
+                         "gymnasium.vector.AsyncVectorEnv for this environment" % (what, space))
+    return space
+
+
+# --- info encoding: numeric values in slots, the rest through the pipe ----------------------
+_EXACT_IN_FLOAT64 = {np.dtype(t).str for t in (np.float16, np.float32, np.float64, np.int8,
+                                                 np.int16, np.int32, np.uint8, np.uint16,
+                                                 np.uint32, np.bool_)}
+
+
+def _encode_info(info, slots):
+    """(layout, extras): layout is a tuple of (key, kind, width), one per key in the info's
+    order, kind "float", "int", "bool", a numpy dtype string, "tuple" (of Python floats,
+    width = length) or "extra" (the value is in extras, to be pickled); the numeric values are
+    written into `slots` (a float64 row) in layout order, each exact."""
+    layout, extras, used = [], None, 0
+    for key, value in info.items():
+        kind, width = "extra", 0
+        t = type(value)
+        if t is float:
+            kind, width = "float", 1
+        elif t is bool:
+            kind, width = "bool", 1
+        elif t is int:
+            if -2 ** 53 <= value <= 2 ** 53:
+                kind, width = "int", 1
+        elif t is tuple:
+            if all(type(v) is float for v in value):
+                kind, width = "tuple", len(value)
+        elif isinstance(value, np.generic) and value.dtype.str in _EXACT_IN_FLOAT64:
+            kind, width = value.dtype.str, 1
+        if kind != "extra" and used + width > MAX_SLOTS:
+            kind, width = "extra", 0
+        if kind == "extra":
+            if extras is None:
+                extras = {}
+            extras[key] = value
+        elif width == 1:
+            slots[used] = value
+        elif width:
+            slots[used:used + width] = value
+        used += width
+        layout.append((key, kind, width))
+    return tuple(layout), extras
+
+
+def _decode_info(layout, slots, extras):
+    """The info dict _encode_info was given: same keys in the same order, same types."""
+    info, at = {}, 0
+    for key, kind, width in layout:
+        if kind == "float":
+            info[key] = float(slots[at])
+        elif kind == "int":
+            info[key] = int(slots[at])
+        elif kind == "bool":
+            info[key] = bool(slots[at])
+        elif kind == "tuple":
+            info[key] = tuple(slots[at:at + width].tolist())
+        elif kind == "extra":
+            info[key] = extras[key]
+        else:
+            info[key] = np.dtype(kind).type(slots[at])
+        at += width
+    return info
+
+
+_ARRAY_DTYPE = {"float": np.dtype(float), "int": np.dtype(int), "bool": np.dtype(np.bool_)}
+
+
+def _merge_plan(layout):
+    """For _merge_same_layout: (key, "_" + key, kind's array dtype or None for a tuple,
+    first slot, width) per key, and the slots used."""
+    plan, at = [], 0
+    for key, kind, width in layout:
+        dtype = None if kind == "tuple" else _ARRAY_DTYPE.get(kind) or np.dtype(kind)
+        plan.append((key, "_" + key, dtype, at, width))
+        at += width
+    return tuple(plan), at
+
+
+def _merge_same_layout(plan, used, slots):
+    """The merged infos AsyncVectorEnv builds (gymnasium's VectorEnv._add_info) when every
+    sub-environment's info has the same layout and no extras: one array per key, in key
+    order, each followed by its all-True mask. (One copy of the slots, then rows of it.)"""
+    n = slots.shape[0]
+    columns = slots[:, :used].T.copy()
+    masks = np.ones((len(plan), n), dtype=np.bool_)
+    infos = {}
+    for k, (key, mask_key, dtype, at, width) in enumerate(plan):
+        if dtype is None:
+            array = np.empty(n, dtype=object)
+            for i, row in enumerate(columns[at:at + width].T.tolist()):
+                array[i] = tuple(row)
+        elif dtype.char == "d":
+            array = columns[at]
+        else:
+            array = columns[at].astype(dtype)
+        infos[key] = array
+        infos[mask_key] = masks[k]
+    return infos
+
+
+# --- the worker ----------------------------------------------------------------------------
+def _wait_go(go, spin, parent_pid):
+    """Takes the "go" semaphore: tries without blocking for `spin` seconds (yielding the core
+    to any other runnable thread between tries), then blocks; exits if the learner is gone."""
+    if spin > 0:
+        deadline = time.perf_counter() + spin
+        while True:
+            if go.acquire(False):
+                return
+            if time.perf_counter() > deadline:
+                break
+            os.sched_yield()
+    while not go.acquire(True, 1.0):
+        if os.getppid() != parent_pid:
+            os._exit(0)                      # the learner died without closing us
+
+
+def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, autoreset_mode,
+            spin, cpu):
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})     # Ctrl-C is the learner's
+    parent_pipe.close()
+    if cpu is not None:
+        try:
+            os.sched_setaffinity(0, {cpu})
+        except OSError:
+            pass
+    try:
+        env = env_fn()
+    except Exception as err:                 # reported by the learner's constructor
+        pipe.send(("error", _error_payload(err, "make", "the environment function")))
+        return
+    actions, observations, rewards, terminations, truncations, command, status, slots = (
+        _view(s) for s in shared)
+    row = slots[index]
+    pipe.send(("ready", None))
+    scalar_action = actions.ndim == 1
+    autoreset = False
+    sent_layout = None
+    try:
+        while True:
+            _wait_go(go, spin, parent_pid)
+            message = None if command[index] == STEP else pipe.recv()
+            call = "step" if message is None else message[0]
+            if call == "close":
+                break
+            if call not in ("step", "reset"):             # call / setattr / apply
+                answer = _answer(env, message)
+                status[index] = FOLLOWS
+                done.release()
+                pipe.send(("result", answer))
+                continue
+            action = None
+            try:
+                if call == "step":
+                    if message is not None:  # an action the shared array cannot hold as is
+                        action = message[1]
+                    else:
+                        action = actions[index] if scalar_action else actions[index].copy()
+                    if autoreset_mode is AutoresetMode.NEXT_STEP and autoreset:
+                        observation, info = env.reset()
+                        reward, terminated, truncated = 0.0, False, False
+                    else:
+                        observation, reward, terminated, truncated, info = env.step(action)
+                        if autoreset_mode is AutoresetMode.SAME_STEP and (terminated or truncated):
+                            reset_observation, reset_info = env.reset()
+                            info = {"final_info": info, "final_obs": observation, **reset_info}
+                            observation = reset_observation
+                    autoreset = terminated or truncated
+                    rewards[index] = reward
+                    terminations[index] = terminated
+                    truncations[index] = truncated
+                else:
+                    observation, info = env.reset(**message[1])
+                    autoreset = False
+                observations[index] = observation
+                layout, extras = _encode_info(info, row)
+            except Exception as err:
+                given = repr(action) if call == "step" else "reset(%s)" % ", ".join(
+                    "%s=%r" % item for item in message[1].items())
+                status[index] = FOLLOWS
+                done.release()
+                pipe.send(("error", _error_payload(err, call, given)))
+                continue
+            if layout == sent_layout and extras is None:
+                status[index] = PLAIN
+                done.release()
+            else:
+                status[index] = FOLLOWS
+                done.release()
+                pipe.send(("info", None if layout == sent_layout else layout, extras))
+                sent_layout = layout
+    finally:
+        env.close()
+
+
+def _answer(env, message):
+    call = message[0]
+    try:
+        if call == "call":
+            name, args, kwargs = message[1:]
+            attribute = env.get_wrapper_attr(name)
+            return ("ok", attribute(*args, **kwargs) if callable(attribute) else attribute)
+        if call == "setattr":
+            env.set_wrapper_attr(message[1], message[2])
+            return ("ok", None)
+        if call == "apply":
+            function, args = message[1:]
+            return ("ok", function(env, *args))
+        raise ValueError("unknown message %r" % (call,))
+    except Exception as err:
+        return ("error", _error_payload(err, call, repr(message[1:])))
+
+
+def _error_payload(err, call, given):
+    import pickle
+    try:
+        pickled = pickle.dumps(err)
+        pickle.loads(pickled)
+    except Exception:
+        pickled = None
+    return {"call": call, "given": given, "type": type(err).__name__, "message": str(err),
+            "pickled": pickled, "traceback": traceback.format_exc()}
+
+
+# --- the learner's side ----------------------------------------------------------------------
+class SharedMemoryVectorEnv(VectorEnv):
+    """`env_fns`: functions that make the sub-environments (all with the same spaces).
+    autoreset_mode: NEXT_STEP (default), SAME_STEP or DISABLED, as AsyncVectorEnv.
+    context: multiprocessing start method (None: its default, as AsyncVectorEnv; "spawn" and
+    "forkserver" need the main module importable, `if __name__ == "__main__":`).
+    spin [s]: how long a worker polls for the next step before it blocks (0: always block).
+    pin: pin worker i to the i-th core this process may use (round robin).
+    copy: return copies of the observations (True), or the shared array itself."""
+
+    def __init__(self, env_fns, autoreset_mode=AutoresetMode.NEXT_STEP, context=None,
+                 spin=0.0, pin=False, copy=True):
+        self.env_fns = list(env_fns)
+        self.num_envs = len(self.env_fns)
+        if self.num_envs < 1:
+            raise ValueError("SharedMemoryVectorEnv needs at least one environment function")
+        self.autoreset_mode = AutoresetMode(autoreset_mode)
+        self.copy = copy
+        self.processes, self._pipes = [], []
+        self._broken = None
+        self._pending = None
+        self.closed = False
+        dummy = self.env_fns[0]()
+        try:
+            self.metadata = dict(dummy.metadata, autoreset_mode=self.autoreset_mode)
+            self.render_mode = dummy.render_mode
+            self.single_observation_space = _fixed_shape_space(dummy.observation_space,
+                                                               "observation")
+            self.single_action_space = _fixed_shape_space(dummy.action_space, "action")
+        finally:
+            dummy.close()
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        ctx = multiprocessing.get_context(context)
+        n = self.num_envs
+        obs, act = self.single_observation_space, self.single_action_space
+        shared = [_shared_array(ctx, act.dtype, (n,) + tuple(act.shape)),
+                  _shared_array(ctx, obs.dtype, (n,) + tuple(obs.shape)),
+                  _shared_array(ctx, np.float64, (n,)),
+                  _shared_array(ctx, np.bool_, (n,)),
+                  _shared_array(ctx, np.bool_, (n,)),
+                  _shared_array(ctx, np.int32, (n,)),
+                  _shared_array(ctx, np.int32, (n,)),
+                  _shared_array(ctx, np.float64, (n, MAX_SLOTS))]
+        (self._actions, self._observations, self._rewards, self._terminations,
+         self._truncations, self._command, self._status, self._slots) = (
+            _view(s) for s in shared)
+        self._go = [ctx.Semaphore(0) for _ in range(n)]
+        self._done = [ctx.Semaphore(0) for _ in range(n)]
+        self._layouts = [None] * n
+        self._extras = [None] * n
+        self._plan = None               # (layout, merge plan, slots used) of the last merge
+        cores = sorted(os.sched_getaffinity(0))
+        try:
+            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})   # inherited by workers
+            try:
+                for i, env_fn in enumerate(self.env_fns):
+                    parent_pipe, child_pipe = ctx.Pipe()
+                    cpu = cores[i % len(cores)] if pin else None
+                    process = ctx.Process(
+                        target=_worker, name="SharedMemoryVectorEnv-%d" % i, daemon=True,
+                        args=(i, CloudpickleWrapper(env_fn), child_pipe, parent_pipe, shared,
+                              self._go[i], self._done[i], os.getpid(), self.autoreset_mode,
+                              float(spin), cpu))
+                    process.start()
+                    child_pipe.close()
+                    self.processes.append(process)
+                    self._pipes.append(parent_pipe)
+            finally:
+                signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+            for i in range(n):
+                kind, payload = self._receive(i, "start")
+                if kind == "error":
+                    raise self._error(i, payload)
+        except BaseException:
+            self.close(terminate=True)
+            raise
+
+    # --- waiting, with liveness checks ----------------------------------------------------
+    def _died(self, i, during):
+        process = self.processes[i]
+        process.join(0.1)
+        code = process.exitcode
+        how = ("killed by %s" % signal.Signals(-code).name if code is not None and code < 0
+               else "exit code %s" % code)
+        self._broken = WorkerDiedError(
+            "SharedMemoryVectorEnv: sub-environment %d's worker (pid %d) died during %s (%s); "
+            "close() this vector env and make a new one" % (i, process.pid, during, how))
+        return self._broken
+
+    def _wait_done(self, i, during):
+        done, process = self._done[i], self.processes[i]
+        while not done.acquire(True, LIVENESS):
+            if not process.is_alive():
+                raise self._died(i, during)
+
+    def _receive(self, i, during):
+        pipe, process = self._pipes[i], self.processes[i]
+        while not pipe.poll(LIVENESS):
+            if not process.is_alive() and not pipe.poll(0):
+                raise self._died(i, during)
+        try:
+            return pipe.recv()
+        except (EOFError, OSError):
+            raise self._died(i, during) from None
+
+    def _error(self, i, payload):
+        cause = None
+        if payload["pickled"] is not None:
+            import pickle
+            cause = pickle.loads(payload["pickled"])
+        else:
+            cause = _RemoteError("%s: %s" % (payload["type"], payload["message"]))
+        error = SubEnvironmentError(
+            "sub-environment %d (worker pid %d) raised %s in %s, given %s: %s"
+            % (i, self.processes[i].pid, payload["type"], payload["call"], payload["given"],
+               payload["message"]),
+            i, self.processes[i].pid, payload["call"], payload["given"], payload["type"],
+            payload["traceback"])
+        error.__cause__ = cause
+        return error
+
+    def _check_usable(self):
+        if self.closed:
+            from gymnasium.error import ClosedEnvironmentError
+            raise ClosedEnvironmentError("SharedMemoryVectorEnv: used after close()")
+        if self._broken is not None:
+            raise self._broken
+        if self._pending is not None:
+            raise RuntimeError("SharedMemoryVectorEnv: a %s was interrupted; close() it"
+                               % self._pending)
+
+    def _post(self, i, message=None):
+        if message is None:
+            self._command[i] = STEP
+        else:
+            self._command[i] = MESSAGE
+            self._pipes[i].send(message)
+        self._go[i].release()
+
+    def _collect(self, which, during):
+        """Waits for the workers `which`, reads their messages; (per-worker info source,
+        errors): an info source is "slots" (layout as cached) or None (no info)."""
+        errors, answers = [], {}
+        for i in which:
+            self._wait_done(i, during)
+            if self._status[i] == FOLLOWS:
+                kind, *rest = self._receive(i, during)
+                if kind == "info":
+                    layout, extras = rest
+                    if layout is not None:
+                        self._layouts[i] = layout
+                    self._extras[i] = extras
+                elif kind == "error":
+                    errors.append(self._error(i, rest[0]))
+                elif kind == "result":
+                    answers[i] = rest[0]
+            else:
+                self._extras[i] = None
+        return errors, answers
+
+    def _infos(self, which):
+        layouts = [self._layouts[i] for i in which]
+        if (len(which) == self.num_envs and all(l is layouts[0] or l == layouts[0] for l in layouts)
+                and all(self._extras[i] is None for i in which)):
+            if self._plan is None or self._plan[0] != layouts[0]:
+                self._plan = (layouts[0],) + _merge_plan(layouts[0])
+            return _merge_same_layout(self._plan[1], self._plan[2], self._slots)
+        infos = {}
+        for i in which:
+            infos = self._add_info(infos, _decode_info(self._layouts[i], self._slots[i],
+                                                       self._extras[i]), i)
+        return infos
+
+    def _returned_observations(self):
+        return self._observations.copy() if self.copy else self._observations
+
+    # --- gymnasium API ------------------------------------------------------------------------
+    def reset(self, *, seed=None, options=None):
+        self._check_usable()
+        n = self.num_envs
+        if seed is None:
+            seeds = [None] * n
+        elif isinstance(seed, (int, np.integer)):
+            seeds = [int(seed) + i for i in range(n)]
+        else:
+            seeds = list(seed)
+            if len(seeds) != n:
+                raise ValueError("reset(seed=%r): give one seed or a list of %d" % (seed, n))
+        options = dict(options) if options is not None else None
+        mask = None
+        if options is not None and "reset_mask" in options:
+            mask = np.asarray(options.pop("reset_mask"))
+            if mask.shape != (n,) or mask.dtype != np.bool_ or not mask.any():
+                raise ValueError("reset options reset_mask: give a bool array of shape (%d,) "
+                                 "with at least one True" % n)
+        which = [i for i in range(n) if mask is None or mask[i]]
+        self._pending = "reset"
+        for i in which:
+            self._post(i, ("reset", {"seed": seeds[i], "options": options}))
+        errors, _ = self._collect(which, "reset")
+        self._pending = None
+        if errors:
+            raise errors[0]
+        return self._returned_observations(), self._infos(which)
+
+    def step(self, actions):
+        self._check_usable()
+        n = self.num_envs
+        batch = np.asarray(actions)
+        fits = batch.dtype == self._actions.dtype and batch.shape == self._actions.shape
+        if fits:
+            self._actions[...] = batch
+        elif len(batch) != n:
+            raise ValueError("step: %d actions for %d sub-environments" % (len(batch), n))
+        self._pending = "step"
+        for i in range(n):
+            # an action the shared array would have to cast goes as given, through the pipe
+            self._post(i, None if fits else ("step", actions[i]))
+        errors, _ = self._collect(range(n), "step")
+        self._pending = None
+        if errors:
+            failed = {error.index for error in errors}
+            ok = [i for i in range(n) if i not in failed]
+            rewards, terminations, truncations = (self._rewards.copy(),
+                                                  self._terminations.copy(),
+                                                  self._truncations.copy())
+            for i in failed:
+                rewards[i], terminations[i], truncations[i] = 0.0, False, False
+            errors[0].result = (self._observations.copy(), rewards, terminations, truncations,
+                                self._infos(ok))
+            if len(errors) > 1:
+                errors[0].args = (errors[0].args[0] + "; and: " + "; ".join(
+                    str(e) for e in errors[1:]),)
+            raise errors[0]
+        return (self._returned_observations(), self._rewards.copy(), self._terminations.copy(),
+                self._truncations.copy(), self._infos(range(n)))
+
+    def call(self, name, *args, **kwargs):
+        return self._ask(("call", name, args, kwargs))
+
+    def get_attr(self, name):
+        return self.call(name)
+
+    def set_attr(self, name, values):
+        if not isinstance(values, (list, tuple)):
+            values = [values] * self.num_envs
+        if len(values) != self.num_envs:
+            raise ValueError("set_attr(%r): give one value or %d" % (name, self.num_envs))
+        self._ask([("setattr", name, value) for value in values])
+
+    def apply(self, function, *args):
+        """function(env, *args) in every worker (a picklable function): its results."""
+        return self._ask(("apply", function, args))
+
+    def render(self):
+        return self.call("render")
+
+    def _ask(self, messages):
+        self._check_usable()
+        if isinstance(messages, tuple):
+            messages = [messages] * self.num_envs
+        self._pending = messages[0][0]
+        for i, message in enumerate(messages):
+            self._post(i, message)
+        errors, answers = self._collect(range(self.num_envs), messages[0][0])
+        self._pending = None
+        results = []
+        for i in range(self.num_envs):
+            kind, value = answers[i]
+            if kind == "error":
+                errors.append(self._error(i, value))
+            results.append(value)
+        if errors:
+            raise errors[0]
+        return tuple(results)
+
+    def close_extras(self, terminate=False, **kwargs):
+        """Each worker: "close" (its env closes, it exits), joined by PID for CLOSE_JOIN s;
+        then terminate, then kill. `terminate`: skip the polite part."""
+        if self._pending is not None and not terminate and self._broken is None:
+            try:                               # a step cut short (Ctrl-C): let it finish
+                for i in range(self.num_envs):
+                    if not self._done[i].acquire(True, 2.0):
+                        terminate = True
+                    elif self._status[i] == FOLLOWS and self._pipes[i].poll(2.0):
+                        self._pipes[i].recv()
+            except (EOFError, OSError):
+                terminate = True
+            self._pending = None
+        for i, process in enumerate(self.processes):
+            if not terminate and process.is_alive():
+                try:
+                    self._post(i, ("close",))
+                except (OSError, ValueError):
+                    pass
+        for process in self.processes:
+            process.join(0 if terminate else CLOSE_JOIN)
+            if process.is_alive():
+                process.terminate()
+                process.join(2.0)
+            if process.is_alive():
+                process.kill()
+                process.join()
+        for pipe in self._pipes:
+            pipe.close()
+
+    def close(self, **kwargs):
+        if self.closed:
+            return
+        try:
+            self.close_extras(**kwargs)
+        finally:
+            self.closed = True
+
+    def __del__(self):
+        if not getattr(self, "closed", True) and getattr(self, "processes", None):
+            self.close(terminate=True)
+
+    def __repr__(self):
+        return "SharedMemoryVectorEnv(num_envs=%d)" % self.num_envs
