@@ -9,12 +9,16 @@
 2. Vectorised (--part vector): the same two episodes (seeds s and s + 1, random free starts,
    actions drawn ahead, so no sampler runs in the timed loops) stepped in this process one
    after the other, in one subprocess (an AsyncVectorEnv of one), in two subprocesses at
-   once (AsyncVectorEnv of two), and through stable-baselines3's SubprocVecEnv when it is
-   installed; env steps per second of wall time, each ratio taken within the round. The
+   once (AsyncVectorEnv of two), in m2wr_gym's SharedMemoryVectorEnv of one and of two
+   (shared_vector.py: shared arrays and semaphores instead of pipes), and through
+   stable-baselines3's SubprocVecEnv when it is installed; env steps per second of wall
+   time, each ratio taken within the round. The
    machine's own ceiling for two processes is measured in the same round: two bare Bullet
    steppers in two processes at once against one. Also the CPU each side spends (workers
    per env step, the learner's process per vector step, from /proc) and how busy the two
-   cores were: what separates the figure from the ceiling. Odd rounds run in reverse order.
+   cores were: what separates the figure from the ceiling; for SharedMemoryVectorEnv also
+   its measured wake-ups (learner's post to a worker running, last worker's post to the
+   learner running) and a worker's step as timed inside it. Odd rounds run in reverse order.
 3. Where one in-process control step's CPU time goes, timed inside the env's own steps (see
    breakdown()): Bullet's physics, the contact guard and reads, the one scan observed, the
    rest of the engine, the environment's own Python.
@@ -287,7 +291,9 @@ def in_subprocesses(work, parallel, library="gymnasium", **options):
     AsyncVectorEnv of one env, stretch after stretch) or 2 (both at once, one env per
     worker); library "sb3": stable-baselines3's SubprocVecEnv instead (its default start
     method). Returns env steps/s of wall time, CPU seconds per env step in the workers, CPU
-    seconds per vector step in this (the learner's) process, timed steps only."""
+    seconds per vector step in this (the learner's) process, timed steps only; library
+    "shm": m2wr_gym's SharedMemoryVectorEnv (`options` passed on), then also its timing
+    report (wake-ups and a worker's step, [us])."""
     groups = [work] if parallel == 2 else [[one] for one in work]
     wall = cpu = workers = 0.0
     steps = vector_steps = 0
@@ -312,6 +318,8 @@ def in_subprocesses(work, parallel, library="gymnasium", **options):
                 vector.reset(seed=seeds)
             for batch in batches[:WARMUP]:
                 vector.step(batch)
+            if library == "shm":
+                vector.reset_timing()
             workers_started = sum(cpu_seconds(pid) for pid in pids)
             started, cpu_started = time.perf_counter(), time.process_time()
             for batch in batches[WARMUP:]:
@@ -321,12 +329,14 @@ def in_subprocesses(work, parallel, library="gymnasium", **options):
             workers += sum(cpu_seconds(pid) for pid in pids) - workers_started
             vector_steps += len(batches) - WARMUP
             steps += (len(batches) - WARMUP) * parallel
+        timing = vector.timing_report() if library == "shm" else {}
         finished = True
     finally:
         if vector is not None:
             _close(vector, finished)
-    return {"rate": steps / wall, "worker cpu": workers / steps, "main cpu": cpu / vector_steps,
-            "wall": wall / vector_steps}
+    return dict(timing, rate=steps / wall, **{"worker cpu": workers / steps,
+                                              "main cpu": cpu / vector_steps,
+                                              "wall": wall / vector_steps})
 
 
 def _close(vector, finished):
@@ -339,7 +349,9 @@ def _close(vector, finished):
         if process.is_alive():
             process.terminate()
         process.join()
-    if isinstance(vector, AsyncVectorEnv):          # its pipes and shared memory
+    if isinstance(vector, SharedMemoryVectorEnv):   # its pipes
+        vector.close(terminate=True)
+    elif isinstance(vector, AsyncVectorEnv):        # its pipes and shared memory
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
@@ -367,7 +379,9 @@ def vector_round(r, steps, with_sb3):
     seconds = steps * 0.1
     runs = [("in process", lambda: in_process(work)),
             ("1 subprocess", lambda: in_subprocesses(work, 1)),
-            ("2 subprocesses", lambda: in_subprocesses(work, 2))]
+            ("2 subprocesses", lambda: in_subprocesses(work, 2)),
+            ("1 shm subprocess", lambda: in_subprocesses(work, 1, "shm")),
+            ("2 shm subprocesses", lambda: in_subprocesses(work, 2, "shm"))]
     if with_sb3:
         runs.append(("2 SB3 subprocesses", lambda: in_subprocesses(work, 2, "sb3")))
     runs += [("bare Bullet", lambda: bare_bullet(seconds)[0]),
@@ -380,6 +394,9 @@ def print_vector_round(r, rounds, f):
     line = ("[bench] vector round %d/%d: env steps/s in process %.0f, 1 subprocess %.0f, "
             "2 subprocesses %.0f (%.2fx in process, %.2fx 1 subprocess)"
             % (r + 1, rounds, one, sub, two, two / one, two / sub))
+    shm1, shm2 = f["1 shm subprocess"]["rate"], f["2 shm subprocesses"]["rate"]
+    line += ("; shared-memory vector env: 1 subprocess %.0f, 2 subprocesses %.0f (%.2fx in "
+             "process, %.2fx its 1)" % (shm1, shm2, shm2 / one, shm2 / shm1))
     if "2 SB3 subprocesses" in f:
         sb3 = f["2 SB3 subprocesses"]["rate"]
         line += ", 2 SB3 subprocesses %.0f (%.2fx in process)" % (sb3, sb3 / one)
@@ -396,7 +413,8 @@ def print_vector_summary(rounds, steps):
         return "%.2f-%.2f" % (min(values), max(values))
 
     ratio = {}
-    for key in ("1 subprocess", "2 subprocesses", "2 SB3 subprocesses"):
+    for key in ("1 subprocess", "2 subprocesses", "1 shm subprocess", "2 shm subprocesses",
+                "2 SB3 subprocesses"):
         if key in rounds[0]:
             ratio[key] = [f[key]["rate"] / f["in process"]["rate"] for f in rounds]
     two_to_one = [f["2 subprocesses"]["rate"] / f["1 subprocess"]["rate"] for f in rounds]
@@ -407,6 +425,8 @@ def print_vector_summary(rounds, steps):
           % median([f["in process"]["rate"] for f in rounds]))
     for key, label in (("1 subprocess", "one env in a subprocess:"),
                        ("2 subprocesses", "two envs in subprocesses:"),
+                       ("1 shm subprocess", "one in m2wr_gym's shared-memory env:"),
+                       ("2 shm subprocesses", "two in m2wr_gym's shared-memory env:"),
                        ("2 SB3 subprocesses", "two in SB3 SubprocVecEnv:")):
         if key in ratio:
             print("  %-34s %6.0f env steps/s = %.2fx in process (%s)"
@@ -414,6 +434,10 @@ def print_vector_summary(rounds, steps):
                      spread(ratio[key])))
     print("  two in subprocesses / one in a subprocess:   %.2fx (%s)"
           % (median(two_to_one), spread(two_to_one)))
+    shm_two_to_one = [f["2 shm subprocesses"]["rate"] / f["1 shm subprocess"]["rate"]
+                      for f in rounds]
+    print("  two in the shared-memory env / one in it:    %.2fx (%s)"
+          % (median(shm_two_to_one), spread(shm_two_to_one)))
     print("  the machine's ceiling, two bare Bullets at once / one: %.2fx (%s)"
           % (median(ceiling), spread(ceiling)))
     # CPU: what the two cores did per vector step of two envs, against its wall time
@@ -440,6 +464,24 @@ def print_vector_summary(rounds, steps):
     print("  if the two cores did nothing but this work, with no waiting, this CPU per step "
           "would give %.2fx in process (%s); the rest is waiting: for the slower of the two "
           "steps, the pipes' wake-ups, the learner's serial part" % (median(bound), spread(bound)))
+    # the same for the shared-memory vector env, with its own wake-up timing
+    two = [f["2 shm subprocesses"] for f in rounds]
+    one_shm = [f["1 shm subprocess"] for f in rounds]
+    shm_bound = [2 * f["in process"]["cpu"] / (t["worker cpu"] + t["main cpu"] / 2)
+                 for f, t in zip(rounds, two)]
+    print("  shared-memory env: CPU per env step in a worker %.0f us alone, %.0f two at once "
+          "(%.2fx in process); learner per vector step %.0f us with one, %.0f with two; a "
+          "vector step of two takes %.0f us of wall time"
+          % (median([t["worker cpu"] for t in one_shm]) * 1e6,
+             median([t["worker cpu"] for t in two]) * 1e6,
+             median([t["worker cpu"] for t in two]) / inproc,
+             median([t["main cpu"] for t in one_shm]) * 1e6,
+             median([t["main cpu"] for t in two]) * 1e6, median([t["wall"] for t in two]) * 1e6))
+    print("  shared-memory env, two at once: a worker's step %.0f us (timed inside it), "
+          "wake-ups: learner's post -> worker running %.0f us, last worker's post -> learner "
+          "running %.0f us; CPU bound as above %.2fx (%s)"
+          % (median([t["work"] for t in two]), median([t["go"] for t in two]),
+             median([t["wake"] for t in two]), median(shm_bound), spread(shm_bound)))
 
 
 def main(argv=None):

@@ -233,8 +233,10 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, auto
     except Exception as err:                 # reported by the learner's constructor
         pipe.send(("error", _error_payload(err, "make", "the environment function")))
         return
-    actions, observations, rewards, terminations, truncations, command, status, slots = (
-        _view(s) for s in shared)
+    (actions, observations, rewards, terminations, truncations, command, status, slots,
+     clock) = (_view(s) for s in shared)
+    clock = clock[index]
+    now = time.perf_counter
     row = slots[index]
     pipe.send(("ready", None))
     scalar_action = actions.ndim == 1
@@ -243,6 +245,7 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, auto
     try:
         while True:
             _wait_go(go, spin, parent_pid)
+            clock[1] = now()
             message = None if command[index] == STEP else pipe.recv()
             call = "step" if message is None else message[0]
             if call == "close":
@@ -285,6 +288,7 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, auto
                 done.release()
                 pipe.send(("error", _error_payload(err, call, given)))
                 continue
+            clock[2] = now()
             if layout == sent_layout and extras is None:
                 status[index] = PLAIN
                 done.release()
@@ -369,15 +373,17 @@ class SharedMemoryVectorEnv(VectorEnv):
                   _shared_array(ctx, np.bool_, (n,)),
                   _shared_array(ctx, np.int32, (n,)),
                   _shared_array(ctx, np.int32, (n,)),
-                  _shared_array(ctx, np.float64, (n, MAX_SLOTS))]
+                  _shared_array(ctx, np.float64, (n, MAX_SLOTS)),
+                  _shared_array(ctx, np.float64, (n, 3))]
         (self._actions, self._observations, self._rewards, self._terminations,
-         self._truncations, self._command, self._status, self._slots) = (
+         self._truncations, self._command, self._status, self._slots, self._clock) = (
             _view(s) for s in shared)
         self._go = [ctx.Semaphore(0) for _ in range(n)]
         self._done = [ctx.Semaphore(0) for _ in range(n)]
         self._layouts = [None] * n
         self._extras = [None] * n
         self._plan = None               # (layout, merge plan, slots used) of the last merge
+        self.reset_timing()
         cores = sorted(os.sched_getaffinity(0))
         try:
             signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})   # inherited by workers
@@ -464,14 +470,18 @@ class SharedMemoryVectorEnv(VectorEnv):
         else:
             self._command[i] = MESSAGE
             self._pipes[i].send(message)
+        self._clock[i, 0] = time.perf_counter()
         self._go[i].release()
 
     def _collect(self, which, during):
-        """Waits for the workers `which`, reads their messages; (per-worker info source,
-        errors): an info source is "slots" (layout as cached) or None (no info)."""
+        """Waits for the workers `which`, then reads what they sent through their pipes:
+        (errors as SubEnvironmentError, {worker: answer of a call})."""
         errors, answers = [], {}
         for i in which:
             self._wait_done(i, during)
+        if during == "step":
+            self._time(which)
+        for i in which:
             if self._status[i] == FOLLOWS:
                 kind, *rest = self._receive(i, during)
                 if kind == "info":
@@ -486,6 +496,33 @@ class SharedMemoryVectorEnv(VectorEnv):
             else:
                 self._extras[i] = None
         return errors, answers
+
+    def _time(self, which):
+        """Adds this step's waits to self.timing: [s] summed over steps (see timing_report)."""
+        returned = time.perf_counter()
+        clock, timing = self._clock, self.timing
+        timing["steps"] += 1
+        for i in which:
+            timing["go"] += clock[i, 1] - clock[i, 0]
+            timing["work"] += clock[i, 2] - clock[i, 1]
+        timing["wake"] += returned - max(clock[i, 2] for i in which)
+        timing["envs"] += len(which)
+
+    def timing_report(self):
+        """Mean [us] per step since construction (or the last reset_timing()): go = from
+        the learner's post to a worker running (wake-up); work = a worker's step, action read
+        to results written (its reset on autoreset included); wake = from the last worker's
+        post to the learner running again."""
+        t = self.timing
+        steps, envs = max(t["steps"], 1), max(t["envs"], 1)
+        return {"go": t["go"] / envs * 1e6, "work": t["work"] / envs * 1e6,
+                "wake": t["wake"] / steps * 1e6}
+
+    def reset_timing(self):
+        self.timing = dict(steps=0, envs=0, go=0.0, work=0.0, wake=0.0)
+
+    def _info_list(self, which):
+        return [_decode_info(self._layouts[i], self._slots[i], self._extras[i]) for i in which]
 
     def _infos(self, which):
         layouts = [self._layouts[i] for i in which]
@@ -523,16 +560,39 @@ class SharedMemoryVectorEnv(VectorEnv):
                 raise ValueError("reset options reset_mask: give a bool array of shape (%d,) "
                                  "with at least one True" % n)
         which = [i for i in range(n) if mask is None or mask[i]]
+        self._reset(which, seeds, [options] * n)
+        return self._returned_observations(), self._infos(which)
+
+    def reset_each(self, seeds, options):
+        """Resets every sub-environment i with seeds[i] and options[i] (a dict or None):
+        (observations, [info of each])."""
+        self._check_usable()
+        which = range(self.num_envs)
+        self._reset(which, list(seeds), list(options))
+        return self._returned_observations(), self._info_list(which)
+
+    def _reset(self, which, seeds, options):
         self._pending = "reset"
         for i in which:
-            self._post(i, ("reset", {"seed": seeds[i], "options": options}))
+            self._post(i, ("reset", {"seed": seeds[i], "options": options[i]}))
         errors, _ = self._collect(which, "reset")
         self._pending = None
         if errors:
             raise errors[0]
-        return self._returned_observations(), self._infos(which)
 
     def step(self, actions):
+        self._step(actions)
+        return (self._returned_observations(), self._rewards.copy(), self._terminations.copy(),
+                self._truncations.copy(), self._infos(range(self.num_envs)))
+
+    def step_each(self, actions):
+        """As step(), with the infos as a list of each sub-environment's info dict (as
+        stable-baselines3 wants them) instead of merged arrays."""
+        self._step(actions)
+        return (self._returned_observations(), self._rewards.copy(), self._terminations.copy(),
+                self._truncations.copy(), self._info_list(range(self.num_envs)))
+
+    def _step(self, actions):
         self._check_usable()
         n = self.num_envs
         batch = np.asarray(actions)
@@ -561,11 +621,15 @@ class SharedMemoryVectorEnv(VectorEnv):
                 errors[0].args = (errors[0].args[0] + "; and: " + "; ".join(
                     str(e) for e in errors[1:]),)
             raise errors[0]
-        return (self._returned_observations(), self._rewards.copy(), self._terminations.copy(),
-                self._truncations.copy(), self._infos(range(n)))
 
     def call(self, name, *args, **kwargs):
-        return self._ask(("call", name, args, kwargs))
+        """env.name(*args, **kwargs) in every sub-environment (or env.name when not
+        callable), through its wrappers: a tuple of the results."""
+        return self._ask({i: ("call", name, args, kwargs) for i in range(self.num_envs)})
+
+    def call_at(self, indices, name, *args, **kwargs):
+        """As call(), in the sub-environments `indices` only: their results, in that order."""
+        return self._ask({i: ("call", name, args, kwargs) for i in indices})
 
     def get_attr(self, name):
         return self.call(name)
@@ -575,26 +639,31 @@ class SharedMemoryVectorEnv(VectorEnv):
             values = [values] * self.num_envs
         if len(values) != self.num_envs:
             raise ValueError("set_attr(%r): give one value or %d" % (name, self.num_envs))
-        self._ask([("setattr", name, value) for value in values])
+        self._ask({i: ("setattr", name, value) for i, value in enumerate(values)})
 
-    def apply(self, function, *args):
-        """function(env, *args) in every worker (a picklable function): its results."""
-        return self._ask(("apply", function, args))
+    def set_attr_at(self, indices, name, value):
+        self._ask({i: ("setattr", name, value) for i in indices})
+
+    def apply(self, function, *args, indices=None):
+        """function(env, *args) in every worker (or those `indices`), `function` picklable
+        (a module's function): a tuple of its results."""
+        indices = range(self.num_envs) if indices is None else indices
+        return self._ask({i: ("apply", function, args) for i in indices})
 
     def render(self):
         return self.call("render")
 
     def _ask(self, messages):
+        """Sends messages[i] to worker i, waits for those workers: their answers in order."""
         self._check_usable()
-        if isinstance(messages, tuple):
-            messages = [messages] * self.num_envs
-        self._pending = messages[0][0]
-        for i, message in enumerate(messages):
-            self._post(i, message)
-        errors, answers = self._collect(range(self.num_envs), messages[0][0])
+        which = list(messages)
+        self._pending = "call"
+        for i in which:
+            self._post(i, messages[i])
+        errors, answers = self._collect(which, "call")
         self._pending = None
         results = []
-        for i in range(self.num_envs):
+        for i in which:
             kind, value = answers[i]
             if kind == "error":
                 errors.append(self._error(i, value))
