@@ -12,12 +12,14 @@
    once (AsyncVectorEnv of two), in m2wr_gym's SharedMemoryVectorEnv of one and of two
    (shared_vector.py: shared arrays and semaphores instead of pipes), and through
    stable-baselines3's SubprocVecEnv when it is installed; env steps per second of wall
-   time, each ratio taken within the round. The
-   machine's own ceiling for two processes is measured in the same round: two bare Bullet
-   steppers in two processes at once against one. Also the CPU each side spends (workers
-   per env step, the learner's process per vector step, from /proc) and how busy the two
-   cores were: what separates the figure from the ceiling; for SharedMemoryVectorEnv also
-   its measured wake-ups (learner's post to a worker running, last worker's post to the
+   time, each ratio taken within the round. The machine's own ceiling for two processes
+   is measured in the same round: two bare Bullet steppers in two processes at once
+   against one; and the environments' own: the two stretches stepped at once in two
+   processes with no vector env and no lockstep (each as in process) against one in
+   process, the most any vector env could give. Also the CPU each side spends (workers per
+   env step, the learner's process per vector step, from /proc) and how busy the two cores
+   were: what separates the figure from the ceiling; for SharedMemoryVectorEnv also its
+   measured wake-ups (learner's post to a worker running, last worker's post to the
    learner running) and a worker's step as timed inside it. Odd rounds run in reverse order.
 3. Where one in-process control step's CPU time goes, timed inside the env's own steps (see
    breakdown()): Bullet's physics, the contact guard and reads, the one scan observed, the
@@ -76,6 +78,10 @@ def _bare_bullet_worker(seconds, start, results):
     results.put(bare_bullet(seconds, start)[0])
 
 
+def _free_env_worker(stretch, start, results):
+    results.put(in_process([stretch], start)["rate"])
+
+
 @contextlib.contextmanager
 def children_ignore_ctrl_c():
     """Processes started inside have SIGINT blocked for good (they inherit the signal mask),
@@ -88,13 +94,12 @@ def children_ignore_ctrl_c():
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
-def two_bare_bullets(seconds):
-    """The machine's own ceiling for two processes: summed sim s / wall s of two bare Bullet
-    steppers running at once (each as bare_bullet), in two processes."""
+def _two_at_once(target, args):
+    """Runs target(*args[k], barrier, results) in two spawned processes that start their
+    timed loops together; the sum of what they put in results."""
     context = multiprocessing.get_context("spawn")
     start, results = context.Barrier(2), context.Queue()
-    workers = [context.Process(target=_bare_bullet_worker, args=(seconds, start, results))
-               for _ in range(2)]
+    workers = [context.Process(target=target, args=tuple(a) + (start, results)) for a in args]
     finished = False
     try:
         with children_ignore_ctrl_c():
@@ -111,6 +116,20 @@ def two_bare_bullets(seconds):
             if worker.is_alive():
                 worker.terminate()
                 worker.join()
+
+
+def two_bare_bullets(seconds):
+    """The machine's own ceiling for two processes: summed sim s / wall s of two bare Bullet
+    steppers running at once (each as bare_bullet), in two processes."""
+    return _two_at_once(_bare_bullet_worker, [(seconds,), (seconds,)])
+
+
+def two_free_envs(work):
+    """The environment's own ceiling for two processes: summed env steps/s of the two
+    stretches stepped at once in two processes, each in process with no vector env and no
+    lockstep (as in_process): what two envs get from the two cores with nothing between
+    them and the learner."""
+    return _two_at_once(_free_env_worker, [(stretch,) for stretch in work])
 
 
 def drawn_actions(env, steps, seed):
@@ -260,11 +279,13 @@ def stretches(seed, steps):
     return work
 
 
-def in_process(work):
+def in_process(work, start=None):
     """The stretches one after the other in this process: env steps/s of wall time and CPU
     seconds per env step (timed steps only). An episode's end is followed by a reset in
     place of the next action, as AsyncVectorEnv's autoreset does."""
     env = make()
+    if start is not None:
+        start.wait()                       # a barrier: two_free_envs starts two at once
     wall = cpu = 0.0
     timed = 0
     for seed, chosen in work:
@@ -385,7 +406,8 @@ def vector_round(r, steps, with_sb3):
     if with_sb3:
         runs.append(("2 SB3 subprocesses", lambda: in_subprocesses(work, 2, "sb3")))
     runs += [("bare Bullet", lambda: bare_bullet(seconds)[0]),
-             ("2 bare Bullets", lambda: two_bare_bullets(seconds))]
+             ("2 bare Bullets", lambda: two_bare_bullets(seconds)),
+             ("2 free envs", lambda: two_free_envs(work))]
     return {name: run() for name, run in (runs[::-1] if r % 2 else runs)}
 
 
@@ -400,8 +422,8 @@ def print_vector_round(r, rounds, f):
     if "2 SB3 subprocesses" in f:
         sb3 = f["2 SB3 subprocesses"]["rate"]
         line += ", 2 SB3 subprocesses %.0f (%.2fx in process)" % (sb3, sb3 / one)
-    print(line + "; ceiling: 2 bare Bullets %.2fx one" % (f["2 bare Bullets"] / f["bare Bullet"]),
-          flush=True)
+    print(line + "; ceilings: 2 bare Bullets %.2fx one, 2 free-running envs %.2fx in process"
+          % (f["2 bare Bullets"] / f["bare Bullet"], f["2 free envs"] / one), flush=True)
 
 
 def print_vector_summary(rounds, steps):
@@ -421,7 +443,7 @@ def print_vector_summary(rounds, steps):
     ceiling = [f["2 bare Bullets"] / f["bare Bullet"] for f in rounds]
     print("\nvectorised (median of %d rounds, same-round ratios, range in brackets; 2 episodes "
           "x %d env steps, the same actions each way):" % (len(rounds), steps))
-    print("  one env in process:                %6.0f env steps/s"
+    print("  one env in process:                    %6.0f env steps/s"
           % median([f["in process"]["rate"] for f in rounds]))
     for key, label in (("1 subprocess", "one env in a subprocess:"),
                        ("2 subprocesses", "two envs in subprocesses:"),
@@ -429,7 +451,7 @@ def print_vector_summary(rounds, steps):
                        ("2 shm subprocesses", "two in m2wr_gym's shared-memory env:"),
                        ("2 SB3 subprocesses", "two in SB3 SubprocVecEnv:")):
         if key in ratio:
-            print("  %-34s %6.0f env steps/s = %.2fx in process (%s)"
+            print("  %-38s %6.0f env steps/s = %.2fx in process (%s)"
                   % (label, median([f[key]["rate"] for f in rounds]), median(ratio[key]),
                      spread(ratio[key])))
     print("  two in subprocesses / one in a subprocess:   %.2fx (%s)"
@@ -440,6 +462,9 @@ def print_vector_summary(rounds, steps):
           % (median(shm_two_to_one), spread(shm_two_to_one)))
     print("  the machine's ceiling, two bare Bullets at once / one: %.2fx (%s)"
           % (median(ceiling), spread(ceiling)))
+    free = [f["2 free envs"] / f["in process"]["rate"] for f in rounds]
+    print("  the envs' ceiling, two envs free-running in two processes (no vector env, no "
+          "lockstep) / one in process: %.2fx (%s)" % (median(free), spread(free)))
     # CPU: what the two cores did per vector step of two envs, against its wall time
     inproc = median([f["in process"]["cpu"] for f in rounds])
     w1 = median([f["1 subprocess"]["worker cpu"] for f in rounds])

@@ -236,7 +236,7 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, auto
     (actions, observations, rewards, terminations, truncations, command, status, slots,
      clock) = (_view(s) for s in shared)
     clock = clock[index]
-    now = time.perf_counter
+    now, cpu_now = time.perf_counter, time.thread_time
     row = slots[index]
     pipe.send(("ready", None))
     scalar_action = actions.ndim == 1
@@ -246,6 +246,7 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, auto
         while True:
             _wait_go(go, spin, parent_pid)
             clock[1] = now()
+            cpu_started = cpu_now()
             message = None if command[index] == STEP else pipe.recv()
             call = "step" if message is None else message[0]
             if call == "close":
@@ -289,6 +290,7 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, auto
                 pipe.send(("error", _error_payload(err, call, given)))
                 continue
             clock[2] = now()
+            clock[3] = cpu_now() - cpu_started
             if layout == sent_layout and extras is None:
                 status[index] = PLAIN
                 done.release()
@@ -374,7 +376,7 @@ class SharedMemoryVectorEnv(VectorEnv):
                   _shared_array(ctx, np.int32, (n,)),
                   _shared_array(ctx, np.int32, (n,)),
                   _shared_array(ctx, np.float64, (n, MAX_SLOTS)),
-                  _shared_array(ctx, np.float64, (n, 3))]
+                  _shared_array(ctx, np.float64, (n, 4))]
         (self._actions, self._observations, self._rewards, self._terminations,
          self._truncations, self._command, self._status, self._slots, self._clock) = (
             _view(s) for s in shared)
@@ -505,21 +507,23 @@ class SharedMemoryVectorEnv(VectorEnv):
         for i in which:
             timing["go"] += clock[i, 1] - clock[i, 0]
             timing["work"] += clock[i, 2] - clock[i, 1]
+            timing["work cpu"] += clock[i, 3]
         timing["wake"] += returned - max(clock[i, 2] for i in which)
         timing["envs"] += len(which)
 
     def timing_report(self):
         """Mean [us] per step since construction (or the last reset_timing()): go = from
         the learner's post to a worker running (wake-up); work = a worker's step, action read
-        to results written (its reset on autoreset included); wake = from the last worker's
-        post to the learner running again."""
+        to results written (its reset on autoreset included), "work cpu" the CPU time of that;
+        wake = from the last worker's post to the learner running again."""
         t = self.timing
         steps, envs = max(t["steps"], 1), max(t["envs"], 1)
         return {"go": t["go"] / envs * 1e6, "work": t["work"] / envs * 1e6,
-                "wake": t["wake"] / steps * 1e6}
+                "work cpu": t["work cpu"] / envs * 1e6, "wake": t["wake"] / steps * 1e6}
 
     def reset_timing(self):
-        self.timing = dict(steps=0, envs=0, go=0.0, work=0.0, wake=0.0)
+        self.timing = {"steps": 0, "envs": 0, "go": 0.0, "work": 0.0, "work cpu": 0.0,
+                       "wake": 0.0}
 
     def _info_list(self, which):
         return [_decode_info(self._layouts[i], self._slots[i], self._extras[i]) for i in which]

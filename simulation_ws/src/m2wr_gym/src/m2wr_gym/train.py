@@ -31,6 +31,9 @@ def parse_args(argv=None):
     p.add_argument("--timesteps", type=int, default=300000, help="environment steps in all")
     p.add_argument("--envs", type=int, default=2, help="environments in subprocesses (1: in "
                    "this process)")
+    p.add_argument("--vec-env", default="shared", choices=("shared", "subproc"),
+                   help="with --envs > 1: m2wr_gym's shared-memory vector env (sb3_vector.py) "
+                        "or SB3's SubprocVecEnv")
     p.add_argument("--observation", default="regions", choices=("regions", "scan"))
     p.add_argument("--downsample", type=int, default=1)
     p.add_argument("--episode-seconds", type=float, default=60.0,
@@ -155,7 +158,14 @@ def main(argv=None):
     probe.close()
     monitors = [os.path.join(args.out, "%d.monitor.csv" % i) for i in range(args.envs)]
     builders = [make_env(kwargs, monitors[i]) for i in range(args.envs)]
-    venv = SubprocVecEnv(builders) if args.envs > 1 else DummyVecEnv(builders)
+    if args.envs == 1:
+        venv = DummyVecEnv(builders)
+    elif args.vec_env == "shared":
+        from .sb3_vector import SharedMemoryVecEnv
+        # forkserver, as SubprocVecEnv: workers are not forks of a process running torch
+        venv = SharedMemoryVecEnv(builders, context="forkserver")
+    else:
+        venv = SubprocVecEnv(builders)
     venv.seed(args.seed)
     hidden = list(args.hidden)
     if args.algo == "ppo":

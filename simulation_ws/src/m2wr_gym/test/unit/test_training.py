@@ -23,3 +23,16 @@ def test_a_short_training_run_writes_a_runnable_policy_and_a_curve(tmp_path):
     assert 0 <= policy.act(np.full(5, 3.0)) < 3
     with open(os.path.join(out, "learning_curve.png"), "rb") as f:
         assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+
+
+def test_two_environments_train_through_the_shared_memory_vector_env(tmp_path):
+    from m2wr_gym import train
+    out = str(tmp_path / "run")
+    code = train.main(["--timesteps", "256", "--envs", "2", "--episode-seconds", "3",
+                       "--report-every", "128", "--out", out, "--hidden", "16"])
+    assert code == 0
+    monitors = [os.path.join(out, "%d.monitor.csv" % i) for i in range(2)]
+    steps, returns = train.read_monitor(monitors)
+    assert len(returns) >= 2 * 4                 # 128 steps each, episodes of 30 steps
+    assert all(os.path.getsize(m) > 0 for m in monitors)
+    assert os.path.exists(os.path.join(out, "policy.npz"))
