@@ -203,9 +203,10 @@ def _merge_same_layout(plan, used, slots):
 
 
 # --- the worker ----------------------------------------------------------------------------
-def _wait_go(go, spin, parent_pid):
+def _wait_go(go, spin, learner):
     """Takes the "go" semaphore: tries without blocking for `spin` seconds (yielding the core
-    to any other runnable thread between tries), then blocks; exits if the learner is gone."""
+    to any other runnable thread between tries), then blocks; exits if the learner (a
+    multiprocessing parent_process(), whatever the start method) is gone."""
     if spin > 0:
         deadline = time.perf_counter() + spin
         while True:
@@ -215,14 +216,14 @@ def _wait_go(go, spin, parent_pid):
                 break
             os.sched_yield()
     while not go.acquire(True, 1.0):
-        if os.getppid() != parent_pid:
+        if learner is not None and not learner.is_alive():
             os._exit(0)                      # the learner died without closing us
 
 
-def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, autoreset_mode,
-            spin, cpu):
+def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, spin, cpu):
     signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})     # Ctrl-C is the learner's
     parent_pipe.close()
+    learner = multiprocessing.parent_process()
     if cpu is not None:
         try:
             os.sched_setaffinity(0, {cpu})
@@ -244,7 +245,7 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, parent_pid, auto
     sent_layout = None
     try:
         while True:
-            _wait_go(go, spin, parent_pid)
+            _wait_go(go, spin, learner)
             clock[1] = now()
             cpu_started = cpu_now()
             message = None if command[index] == STEP else pipe.recv()
@@ -396,7 +397,7 @@ class SharedMemoryVectorEnv(VectorEnv):
                     process = ctx.Process(
                         target=_worker, name="SharedMemoryVectorEnv-%d" % i, daemon=True,
                         args=(i, CloudpickleWrapper(env_fn), child_pipe, parent_pipe, shared,
-                              self._go[i], self._done[i], os.getpid(), self.autoreset_mode,
+                              self._go[i], self._done[i], self.autoreset_mode,
                               float(spin), cpu))
                     process.start()
                     child_pipe.close()
@@ -471,7 +472,10 @@ class SharedMemoryVectorEnv(VectorEnv):
             self._command[i] = STEP
         else:
             self._command[i] = MESSAGE
-            self._pipes[i].send(message)
+            try:
+                self._pipes[i].send(message)
+            except OSError:
+                raise self._died(i, message[0]) from None
         self._clock[i, 0] = time.perf_counter()
         self._go[i].release()
 
@@ -693,7 +697,7 @@ class SharedMemoryVectorEnv(VectorEnv):
             if not terminate and process.is_alive():
                 try:
                     self._post(i, ("close",))
-                except (OSError, ValueError):
+                except (OSError, ValueError, WorkerDiedError):
                     pass
         for process in self.processes:
             process.join(0 if terminate else CLOSE_JOIN)

@@ -261,3 +261,17 @@ def test_sb3_adapter_gives_what_subproc_vec_env_gives():
 def make_monitored():
     from stable_baselines3.common.monitor import Monitor
     return Monitor(make())
+
+
+def test_forkserver_workers_wait_for_a_slow_learner():
+    """Workers of a forkserver are not the learner's children: they still wait (> their 1 s
+    liveness check) for the next step."""
+    vector = SharedMemoryVectorEnv([make], context="forkserver")
+    try:
+        vector.reset(seed=0)
+        time.sleep(1.5)
+        obs, *_ = vector.step(np.zeros((1, 2), np.float32))
+        assert obs.shape == (1, 180)
+    finally:
+        vector.close()
+    assert_gone(vector)
