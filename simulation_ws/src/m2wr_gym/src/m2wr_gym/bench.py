@@ -79,7 +79,8 @@ def _bare_bullet_worker(seconds, start, results):
 
 
 def _free_env_worker(stretch, start, results):
-    results.put(in_process([stretch], start)["rate"])
+    f = in_process([stretch], start)
+    results.put((f["steps"], f["first"], f["last"]))
 
 
 @contextlib.contextmanager
@@ -96,7 +97,7 @@ def children_ignore_ctrl_c():
 
 def _two_at_once(target, args):
     """Runs target(*args[k], barrier, results) in two spawned processes that start their
-    timed loops together; the sum of what they put in results."""
+    timed loops together; what they put in results."""
     context = multiprocessing.get_context("spawn")
     start, results = context.Barrier(2), context.Queue()
     workers = [context.Process(target=target, args=tuple(a) + (start, results)) for a in args]
@@ -105,9 +106,9 @@ def _two_at_once(target, args):
         with children_ignore_ctrl_c():
             for worker in workers:
                 worker.start()
-        total = sum(results.get(timeout=600) for _ in workers)
+        answers = [results.get(timeout=600) for _ in workers]
         finished = True
-        return total
+        return answers
     finally:
         for worker in workers:
             if worker.pid is None:
@@ -121,15 +122,18 @@ def _two_at_once(target, args):
 def two_bare_bullets(seconds):
     """The machine's own ceiling for two processes: summed sim s / wall s of two bare Bullet
     steppers running at once (each as bare_bullet), in two processes."""
-    return _two_at_once(_bare_bullet_worker, [(seconds,), (seconds,)])
+    return sum(_two_at_once(_bare_bullet_worker, [(seconds,), (seconds,)]))
 
 
 def two_free_envs(work):
     """The environment's own ceiling for two processes: summed env steps/s of the two
     stretches stepped at once in two processes, each in process with no vector env and no
     lockstep (as in_process): what two envs get from the two cores with nothing between
-    them and the learner."""
-    return _two_at_once(_free_env_worker, [(stretch,) for stretch in work])
+    them and the learner. Env steps/s = both processes' timed steps / the time from the
+    first one's start to the last one's end (perf_counter is system-wide)."""
+    answers = _two_at_once(_free_env_worker, [(stretch,) for stretch in work])
+    return (sum(steps for steps, _, _ in answers)
+            / (max(last for _, _, last in answers) - min(first for _, first, _ in answers)))
 
 
 def drawn_actions(env, steps, seed):
@@ -281,30 +285,35 @@ def stretches(seed, steps):
 
 def in_process(work, start=None):
     """The stretches one after the other in this process: env steps/s of wall time and CPU
-    seconds per env step (timed steps only). An episode's end is followed by a reset in
+    seconds per env step (timed steps only; also their number, and when the first timed
+    step started and the last ended, perf_counter). An episode's end is followed by a reset in
     place of the next action, as AsyncVectorEnv's autoreset does."""
     env = make()
     if start is not None:
         start.wait()                       # a barrier: two_free_envs starts two at once
     wall = cpu = 0.0
     timed = 0
+    first = None
     for seed, chosen in work:
         env.reset(seed=seed)
         ended = False
         for i, action in enumerate(chosen):
             if i == WARMUP:
                 started, cpu_started = time.perf_counter(), time.process_time()
+                first = started if first is None else first
             if ended:
                 env.reset()
                 ended = False
                 continue
             _, _, terminated, truncated, _ = env.step(action)
             ended = terminated or truncated
-        wall += time.perf_counter() - started
+        last = time.perf_counter()
+        wall += last - started
         cpu += time.process_time() - cpu_started
         timed += len(chosen) - WARMUP
     env.close()
-    return {"rate": timed / wall, "cpu": cpu / timed}
+    return {"rate": timed / wall, "cpu": cpu / timed, "steps": timed, "first": first,
+            "last": last}
 
 
 def in_subprocesses(work, parallel, library="gymnasium", **options):
