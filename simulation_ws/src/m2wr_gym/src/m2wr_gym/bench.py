@@ -21,6 +21,7 @@
    were: what separates the figure from the ceiling; for SharedMemoryVectorEnv also its
    measured wake-ups (learner's post to a worker running, last worker's post to the
    learner running) and a worker's step as timed inside it. Odd rounds run in reverse order.
+   Last, the two vector envs' own cost per step, with envs that do nothing (IdleEnv).
 3. Where one in-process control step's CPU time goes, timed inside the env's own steps (see
    breakdown()): Bullet's physics, the contact guard and reads, the one scan observed, the
    rest of the engine, the environment's own Python.
@@ -391,6 +392,55 @@ def _close(vector, finished):
     vector.closed = True
 
 
+class IdleEnv(gymnasium.Env):
+    """An env that does nothing, with m2wr's spaces and info keys (a 720-float observation,
+    six floats and two tuples of info): what a vector env itself costs per step."""
+    observation_space = gymnasium.spaces.Box(0.0, 10.0, (720,), np.float32)
+    action_space = actions.space("continuous")
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self._t = 0.0
+        return np.zeros(720, np.float32), self._info((0.0, 0.0))
+
+    def step(self, action):
+        self._t += 0.1
+        return (np.full(720, self._t, np.float32), 0.0, False, False,
+                self._info(tuple(action.tolist())))
+
+    def _info(self, command):
+        return {"sim_time": self._t, "x": 1.0, "y": 2.0, "yaw": 0.5, "nearest": 3.0,
+                "touched": (), "distance": self._t, "command": command}
+
+
+def vector_overhead(steps=2000):
+    """Wall and learner-CPU [us] per vector step of two IdleEnvs, AsyncVectorEnv and
+    SharedMemoryVectorEnv in turn: the price of the vector env alone, little disturbed by
+    other programs (each side the best of 3 runs)."""
+    batch = np.zeros((2, 2), np.float32)
+    figures = {}
+    for name, build in (("AsyncVectorEnv", AsyncVectorEnv),
+                        ("SharedMemoryVectorEnv", SharedMemoryVectorEnv)):
+        with children_ignore_ctrl_c():
+            vector = build([IdleEnv] * 2)
+        try:
+            vector.reset(seed=0)
+            best = None
+            for _ in range(3):
+                for _ in range(100):
+                    vector.step(batch)
+                started, cpu_started = time.perf_counter(), time.process_time()
+                for _ in range(steps):
+                    vector.step(batch)
+                run = ((time.perf_counter() - started) / steps * 1e6,
+                       (time.process_time() - cpu_started) / steps * 1e6)
+                best = run if best is None or run[0] < best[0] else best
+            figures[name] = best
+        finally:
+            vector.close()
+    return figures
+
+
 def sb3_available():
     try:
         import stable_baselines3  # noqa: F401  (the training extra: scripts/train.sh)
@@ -551,6 +601,10 @@ def main(argv=None):
         if not with_sb3 and not args.no_sb3:
             print("\n(SB3's SubprocVecEnv left out: stable-baselines3 is not installed)")
         print_vector_summary(vector_rounds, args.steps)
+        idle = vector_overhead()
+        print("  the vector env alone (two envs that do nothing, m2wr's observation and info): "
+              + "; ".join("%s %.0f us per vector step, %.0f us of it the learner's CPU"
+                          % (name, wall, cpu) for name, (wall, cpu) in idle.items()))
     return 0
 
 

@@ -422,7 +422,9 @@ class SharedMemoryVectorEnv(VectorEnv):
                else "exit code %s" % code)
         self._broken = WorkerDiedError(
             "SharedMemoryVectorEnv: sub-environment %d's worker (pid %d) died during %s (%s); "
-            "close() this vector env and make a new one" % (i, process.pid, during, how))
+            "close() this vector env and make a new one%s"
+            % (i, process.pid, during, how,
+               " (its traceback, if any, is on stderr above)" if during == "start" else ""))
         return self._broken
 
     def _wait_done(self, i, during):

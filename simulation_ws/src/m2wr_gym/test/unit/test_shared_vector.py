@@ -1,6 +1,7 @@
 """SharedMemoryVectorEnv returns what gymnasium's AsyncVectorEnv returns for the same seeds
 and actions (observations, rewards, flags, merged infos, autoreset), reports an error in one
 sub-environment naming it and goes on, notices a dead worker, and leaves no process."""
+import functools
 import math
 import os
 import signal
@@ -266,7 +267,9 @@ def make_monitored():
 def test_forkserver_workers_wait_for_a_slow_learner():
     """Workers of a forkserver are not the learner's children: they still wait (> their 1 s
     liveness check) for the next step."""
-    vector = SharedMemoryVectorEnv([make], context="forkserver")
+    # (a function the forkserver can import: this test module may not be importable there)
+    vector = SharedMemoryVectorEnv([functools.partial(gymnasium.make, "m2wr_gym:M2wrAvoid-v0",
+                                                      **KWARGS)], context="forkserver")
     try:
         vector.reset(seed=0)
         time.sleep(1.5)
