@@ -81,7 +81,7 @@ def _bare_bullet_worker(seconds, start, results):
 
 def _free_env_worker(stretch, start, results):
     f = in_process([stretch], start)
-    results.put((f["steps"], f["first"], f["last"]))
+    results.put((f["steps"], f["first"], f["last"], f["cpu"]))
 
 
 @contextlib.contextmanager
@@ -131,10 +131,12 @@ def two_free_envs(work):
     stretches stepped at once in two processes, each in process with no vector env and no
     lockstep (as in_process): what two envs get from the two cores with nothing between
     them and the learner. Env steps/s = both processes' timed steps / the time from the
-    first one's start to the last one's end (perf_counter is system-wide)."""
+    first one's start to the last one's end (perf_counter is system-wide); and their CPU
+    seconds per env step."""
     answers = _two_at_once(_free_env_worker, [(stretch,) for stretch in work])
-    return (sum(steps for steps, _, _ in answers)
-            / (max(last for _, _, last in answers) - min(first for _, first, _ in answers)))
+    steps = sum(a[0] for a in answers)
+    return {"rate": steps / (max(a[2] for a in answers) - min(a[1] for a in answers)),
+            "cpu": sum(a[0] * a[3] for a in answers) / steps}
 
 
 def drawn_actions(env, steps, seed):
@@ -482,7 +484,7 @@ def print_vector_round(r, rounds, f):
         sb3 = f["2 SB3 subprocesses"]["rate"]
         line += ", 2 SB3 subprocesses %.0f (%.2fx in process)" % (sb3, sb3 / one)
     print(line + "; ceilings: 2 bare Bullets %.2fx one, 2 free-running envs %.2fx in process"
-          % (f["2 bare Bullets"] / f["bare Bullet"], f["2 free envs"] / one), flush=True)
+          % (f["2 bare Bullets"] / f["bare Bullet"], f["2 free envs"]["rate"] / one), flush=True)
 
 
 def print_vector_summary(rounds, steps):
@@ -521,9 +523,13 @@ def print_vector_summary(rounds, steps):
           % (median(shm_two_to_one), spread(shm_two_to_one)))
     print("  the machine's ceiling, two bare Bullets at once / one: %.2fx (%s)"
           % (median(ceiling), spread(ceiling)))
-    free = [f["2 free envs"] / f["in process"]["rate"] for f in rounds]
+    free = [f["2 free envs"]["rate"] / f["in process"]["rate"] for f in rounds]
+    free_cpu = [f["2 free envs"]["cpu"] / f["in process"]["cpu"] for f in rounds]
     print("  the envs' ceiling, two envs free-running in two processes (no vector env, no "
-          "lockstep) / one in process: %.2fx (%s)" % (median(free), spread(free)))
+          "lockstep) / one in process: %.2fx (%s); their CPU per env step %.0f us, %.2fx in "
+          "process (%s)" % (median(free), spread(free),
+                            median([f["2 free envs"]["cpu"] for f in rounds]) * 1e6,
+                            median(free_cpu), spread(free_cpu)))
     # CPU: what the two cores did per vector step of two envs, against its wall time
     inproc = median([f["in process"]["cpu"] for f in rounds])
     w1 = median([f["1 subprocess"]["worker cpu"] for f in rounds])
