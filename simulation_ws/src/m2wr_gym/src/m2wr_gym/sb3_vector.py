@@ -8,7 +8,6 @@ episode's info with info["terminal_observation"], the observation returned being
 episode's first (the vector env runs in SAME_STEP autoreset mode); reset_infos holds each
 environment's last reset info.
 """
-import numpy as np
 from gymnasium.vector import AutoresetMode
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
