@@ -221,6 +221,56 @@ def _wait_go(go, spin, learner):
             os._exit(0)                      # the learner died without closing us
 
 
+class _Runner:
+    """One sub-environment's side of a step or reset: runs it (autoreset included) and
+    writes what it returns into the shared arrays at `index`; gives the info's (layout,
+    extras) or raises what the environment raised. Used by the workers, and by the
+    learner's process for the sub-environment it steps itself (local=True)."""
+
+    def __init__(self, env, index, views, autoreset_mode):
+        self.env, self.index, self.mode = env, index, autoreset_mode
+        (self.actions, self.observations, self.rewards, self.terminations,
+         self.truncations) = views[:5]
+        self.row = views[7][index]
+        self.scalar_action = self.actions.ndim == 1
+        self.autoreset = False
+
+    def shared_action(self):
+        i = self.index
+        return self.actions[i] if self.scalar_action else self.actions[i].copy()
+
+    def step(self, action):
+        env, i = self.env, self.index
+        if self.mode is AutoresetMode.NEXT_STEP and self.autoreset:
+            observation, info = env.reset()
+            reward, terminated, truncated = 0.0, False, False
+        else:
+            observation, reward, terminated, truncated, info = env.step(action)
+            if self.mode is AutoresetMode.SAME_STEP and (terminated or truncated):
+                reset_observation, reset_info = env.reset()
+                info = {"final_info": info, "final_obs": observation, **reset_info}
+                observation = reset_observation
+        self.autoreset = terminated or truncated
+        self.rewards[i] = reward
+        self.terminations[i] = terminated
+        self.truncations[i] = truncated
+        self.observations[i] = observation
+        return _encode_info(info, self.row)
+
+    def reset(self, kwargs):
+        observation, info = self.env.reset(**kwargs)
+        self.autoreset = False
+        self.observations[self.index] = observation
+        return _encode_info(info, self.row)
+
+
+def _given(call, action, kwargs):
+    """The input of a failed call, for its error message."""
+    if call == "step":
+        return repr(action)
+    return "reset(%s)" % ", ".join("%s=%r" % item for item in kwargs.items())
+
+
 def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, spin, cpu):
     signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})     # Ctrl-C is the learner's
     parent_pipe.close()
@@ -235,14 +285,11 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, 
     except Exception as err:                 # reported by the learner's constructor
         pipe.send(("error", _error_payload(err, "make", "the environment function")))
         return
-    (actions, observations, rewards, terminations, truncations, command, status, slots,
-     clock) = (_view(s) for s in shared)
-    clock = clock[index]
+    views = [_view(s) for s in shared]
+    runner = _Runner(env, index, views, autoreset_mode)
+    command, status, clock = views[5], views[6], views[8][index]
     now, cpu_now = time.perf_counter, time.thread_time
-    row = slots[index]
     pipe.send(("ready", None))
-    scalar_action = actions.ndim == 1
-    autoreset = False
     sent_layout = None
     try:
         while True:
@@ -262,34 +309,16 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, 
             action = None
             try:
                 if call == "step":
-                    if message is not None:  # an action the shared array cannot hold as is
-                        action = message[1]
-                    else:
-                        action = actions[index] if scalar_action else actions[index].copy()
-                    if autoreset_mode is AutoresetMode.NEXT_STEP and autoreset:
-                        observation, info = env.reset()
-                        reward, terminated, truncated = 0.0, False, False
-                    else:
-                        observation, reward, terminated, truncated, info = env.step(action)
-                        if autoreset_mode is AutoresetMode.SAME_STEP and (terminated or truncated):
-                            reset_observation, reset_info = env.reset()
-                            info = {"final_info": info, "final_obs": observation, **reset_info}
-                            observation = reset_observation
-                    autoreset = terminated or truncated
-                    rewards[index] = reward
-                    terminations[index] = terminated
-                    truncations[index] = truncated
+                    # (through the pipe: an action the shared array cannot hold as given)
+                    action = runner.shared_action() if message is None else message[1]
+                    layout, extras = runner.step(action)
                 else:
-                    observation, info = env.reset(**message[1])
-                    autoreset = False
-                observations[index] = observation
-                layout, extras = _encode_info(info, row)
+                    layout, extras = runner.reset(message[1])
             except Exception as err:
-                given = repr(action) if call == "step" else "reset(%s)" % ", ".join(
-                    "%s=%r" % item for item in message[1].items())
                 status[index] = FOLLOWS
                 done.release()
-                pipe.send(("error", _error_payload(err, call, given)))
+                pipe.send(("error", _error_payload(
+                    err, call, _given(call, action, message and message[1]))))
                 continue
             clock[2] = now()
             clock[3] = cpu_now() - cpu_started
