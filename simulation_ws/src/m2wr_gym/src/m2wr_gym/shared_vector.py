@@ -371,17 +371,23 @@ class SharedMemoryVectorEnv(VectorEnv):
     "forkserver" need the main module importable, `if __name__ == "__main__":`).
     spin [s]: how long a worker polls for the next step before it blocks (0: always block).
     pin: pin worker i to the i-th core this process may use (round robin).
+    local: this (the learner's) process steps sub-environment 0 itself, while the workers
+    step the others: one process fewer to wake and to schedule; errors, results and infos as
+    with a worker (its "worker pid" is this process's).
     copy: return copies of the observations (True), or the shared array itself."""
 
     def __init__(self, env_fns, autoreset_mode=AutoresetMode.NEXT_STEP, context=None,
-                 spin=0.0, pin=False, copy=True):
+                 spin=0.0, pin=False, local=False, copy=True):
         self.env_fns = list(env_fns)
         self.num_envs = len(self.env_fns)
         if self.num_envs < 1:
             raise ValueError("SharedMemoryVectorEnv needs at least one environment function")
         self.autoreset_mode = AutoresetMode(autoreset_mode)
         self.copy = copy
-        self.processes, self._pipes = [], []
+        self.processes = []                    # the workers' multiprocessing.Process
+        self._process, self._pipes = {}, {}    # by sub-environment index
+        self._local = None                     # the _Runner of sub-environment 0 if local
+        self._local_message = None             # what it is to do next (None: step)
         self._broken = None
         self._pending = None
         self.closed = False
@@ -393,7 +399,8 @@ class SharedMemoryVectorEnv(VectorEnv):
                                                                "observation")
             self.single_action_space = _fixed_shape_space(dummy.action_space, "action")
         finally:
-            dummy.close()
+            if not local:
+                dummy.close()
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         ctx = multiprocessing.get_context(context)
@@ -408,9 +415,12 @@ class SharedMemoryVectorEnv(VectorEnv):
                   _shared_array(ctx, np.int32, (n,)),
                   _shared_array(ctx, np.float64, (n, MAX_SLOTS)),
                   _shared_array(ctx, np.float64, (n, 4))]
+        views = [_view(s) for s in shared]
         (self._actions, self._observations, self._rewards, self._terminations,
-         self._truncations, self._command, self._status, self._slots, self._clock) = (
-            _view(s) for s in shared)
+         self._truncations, self._command, self._status, self._slots, self._clock) = views
+        if local:
+            self._local = _Runner(dummy, 0, views, self.autoreset_mode)
+        self._workers = list(range(1 if local else 0, n))
         self._go = [ctx.Semaphore(0) for _ in range(n)]
         self._done = [ctx.Semaphore(0) for _ in range(n)]
         self._layouts = [None] * n
@@ -421,7 +431,8 @@ class SharedMemoryVectorEnv(VectorEnv):
         try:
             signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})   # inherited by workers
             try:
-                for i, env_fn in enumerate(self.env_fns):
+                for i in self._workers:
+                    env_fn = self.env_fns[i]
                     parent_pipe, child_pipe = ctx.Pipe()
                     cpu = cores[i % len(cores)] if pin else None
                     process = ctx.Process(
@@ -432,10 +443,10 @@ class SharedMemoryVectorEnv(VectorEnv):
                     process.start()
                     child_pipe.close()
                     self.processes.append(process)
-                    self._pipes.append(parent_pipe)
+                    self._process[i], self._pipes[i] = process, parent_pipe
             finally:
                 signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-            for i in range(n):
+            for i in self._workers:
                 kind, payload = self._receive(i, "start")
                 if kind == "error":
                     raise self._error(i, payload)
@@ -445,7 +456,7 @@ class SharedMemoryVectorEnv(VectorEnv):
 
     # --- waiting, with liveness checks ----------------------------------------------------
     def _died(self, i, during):
-        process = self.processes[i]
+        process = self._process[i]
         process.join(0.1)
         code = process.exitcode
         how = ("killed by %s" % signal.Signals(-code).name if code is not None and code < 0
@@ -458,13 +469,13 @@ class SharedMemoryVectorEnv(VectorEnv):
         return self._broken
 
     def _wait_done(self, i, during):
-        done, process = self._done[i], self.processes[i]
+        done, process = self._done[i], self._process[i]
         while not done.acquire(True, LIVENESS):
             if not process.is_alive():
                 raise self._died(i, during)
 
     def _receive(self, i, during):
-        pipe, process = self._pipes[i], self.processes[i]
+        pipe, process = self._pipes[i], self._process[i]
         while not pipe.poll(LIVENESS):
             if not process.is_alive() and not pipe.poll(0):
                 raise self._died(i, during)
@@ -480,12 +491,12 @@ class SharedMemoryVectorEnv(VectorEnv):
             cause = pickle.loads(payload["pickled"])
         else:
             cause = _RemoteError("%s: %s" % (payload["type"], payload["message"]))
+        pid = self._process[i].pid if i in self._process else os.getpid()
         error = SubEnvironmentError(
-            "sub-environment %d (worker pid %d) raised %s in %s, given %s: %s"
-            % (i, self.processes[i].pid, payload["type"], payload["call"], payload["given"],
-               payload["message"]),
-            i, self.processes[i].pid, payload["call"], payload["given"], payload["type"],
-            payload["traceback"])
+            "sub-environment %d (%s pid %d) raised %s in %s, given %s: %s"
+            % (i, "worker" if i in self._process else "the learner's process,", pid,
+               payload["type"], payload["call"], payload["given"], payload["message"]),
+            i, pid, payload["call"], payload["given"], payload["type"], payload["traceback"])
         error.__cause__ = cause
         return error
 
@@ -500,6 +511,9 @@ class SharedMemoryVectorEnv(VectorEnv):
                                % self._pending)
 
     def _post(self, i, message=None):
+        if i not in self._process:               # the learner's own: run in _collect
+            self._local_message = message
+            return
         if message is None:
             self._command[i] = STEP
         else:
@@ -512,12 +526,16 @@ class SharedMemoryVectorEnv(VectorEnv):
         self._go[i].release()
 
     def _collect(self, which, during):
-        """Waits for the workers `which`, then reads what they sent through their pipes:
-        (errors as SubEnvironmentError, {worker: answer of a call})."""
+        """Runs the learner's own sub-environment if it is in `which` (while the workers,
+        posted already, run theirs), waits for the workers in `which`, then reads what they
+        sent through their pipes: (errors as SubEnvironmentError, {index: call's answer})."""
         errors, answers = [], {}
+        if self._local is not None and 0 in which:
+            self._run_local(errors, answers)
+        which = [i for i in which if i in self._process]
         for i in which:
             self._wait_done(i, during)
-        if during == "step":
+        if during == "step" and which:
             self._time(which)
         for i in which:
             if self._status[i] == FOLLOWS:
@@ -534,6 +552,23 @@ class SharedMemoryVectorEnv(VectorEnv):
             else:
                 self._extras[i] = None
         return errors, answers
+
+    def _run_local(self, errors, answers):
+        runner, message = self._local, self._local_message
+        call = "step" if message is None else message[0]
+        if call not in ("step", "reset"):
+            answers[0] = _answer(runner.env, message)
+            return
+        action = None
+        try:
+            if call == "step":
+                action = runner.shared_action() if message is None else message[1]
+                self._layouts[0], self._extras[0] = runner.step(action)
+            else:
+                self._layouts[0], self._extras[0] = runner.reset(message[1])
+        except Exception as err:
+            errors.append(self._error(0, _error_payload(
+                err, call, _given(call, action, message and message[1]))))
 
     def _time(self, which):
         """Adds this step's waits to self.timing: [s] summed over steps (see timing_report)."""
@@ -714,10 +749,11 @@ class SharedMemoryVectorEnv(VectorEnv):
 
     def close_extras(self, terminate=False, **kwargs):
         """Each worker: "close" (its env closes, it exits), joined by PID for CLOSE_JOIN s;
-        then terminate, then kill. `terminate`: skip the polite part."""
+        then terminate, then kill; the learner's own sub-environment (local) closes here.
+        `terminate`: skip the polite part."""
         if self._pending is not None and not terminate and self._broken is None:
             try:                               # a step cut short (Ctrl-C): let it finish
-                for i in range(self.num_envs):
+                for i in self._process:
                     if not self._done[i].acquire(True, 2.0):
                         terminate = True
                     elif self._status[i] == FOLLOWS and self._pipes[i].poll(2.0):
@@ -725,7 +761,7 @@ class SharedMemoryVectorEnv(VectorEnv):
             except (EOFError, OSError):
                 terminate = True
             self._pending = None
-        for i, process in enumerate(self.processes):
+        for i, process in self._process.items():
             if not terminate and process.is_alive():
                 try:
                     self._post(i, ("close",))
@@ -739,8 +775,10 @@ class SharedMemoryVectorEnv(VectorEnv):
             if process.is_alive():
                 process.kill()
                 process.join()
-        for pipe in self._pipes:
+        for pipe in self._pipes.values():
             pipe.close()
+        if self._local is not None:
+            self._local.env.close()
 
     def close(self, **kwargs):
         if self.closed:
@@ -751,7 +789,7 @@ class SharedMemoryVectorEnv(VectorEnv):
             self.closed = True
 
     def __del__(self):
-        if not getattr(self, "closed", True) and getattr(self, "processes", None):
+        if not getattr(self, "closed", True) and hasattr(self, "_process"):
             self.close(terminate=True)
 
     def __repr__(self):

@@ -64,13 +64,16 @@ def assert_same(a, b, where):
         assert type(a) is type(b) and (a == b or (a != a and b != b)), (where, a, b)
 
 
-@pytest.mark.parametrize("maker, mode", [(make, AutoresetMode.NEXT_STEP),
-                                         (make, AutoresetMode.SAME_STEP),
-                                         (make_discrete, AutoresetMode.NEXT_STEP)])
-def test_same_results_as_async_vector_env(maker, mode):
+@pytest.mark.parametrize("maker, mode, local", [(make, AutoresetMode.NEXT_STEP, False),
+                                                (make, AutoresetMode.SAME_STEP, False),
+                                                (make_discrete, AutoresetMode.NEXT_STEP, False),
+                                                (make, AutoresetMode.NEXT_STEP, True)])
+def test_same_results_as_async_vector_env(maker, mode, local):
+    """local: sub-environment 0 stepped in the learner's process."""
     results = {}
     for cls in (AsyncVectorEnv, SharedMemoryVectorEnv):
-        vector = cls([maker, maker], autoreset_mode=mode)
+        options = {"local": local} if cls is SharedMemoryVectorEnv else {}
+        vector = cls([maker, maker], autoreset_mode=mode, **options)
         try:
             actions = actions_for(vector.action_space, 25)
             results[cls] = trace(vector, actions, seed=[3, 4])
@@ -79,6 +82,7 @@ def test_same_results_as_async_vector_env(maker, mode):
     ours, theirs = results[SharedMemoryVectorEnv], results[AsyncVectorEnv]
     for step, (a, b) in enumerate(zip(theirs, ours)):
         assert_same(a, b, "step %d" % step)
+    assert len(vector.processes) == (1 if local else 2)
     # what was compared: episodes ended and restarted, m2wr moved
     ended = [r for r in ours[1:] if r[3].any()]
     assert len(ended) == 2 and ours[-1][4]["distance"].max() > 0
@@ -275,6 +279,23 @@ def test_forkserver_workers_wait_for_a_slow_learner():
         time.sleep(1.5)
         obs, *_ = vector.step(np.zeros((1, 2), np.float32))
         assert obs.shape == (1, 180)
+    finally:
+        vector.close()
+    assert_gone(vector)
+
+
+def test_an_error_in_the_learners_own_sub_environment_is_named_too():
+    vector = SharedMemoryVectorEnv([make, make], local=True)
+    try:
+        vector.reset(seed=0)
+        good = np.array([0.3, 0.0], np.float32)
+        with pytest.raises(SubEnvironmentError, match=r"sub-environment 0 \(the learner's "
+                                                      r"process, pid %d\) raised InvalidAction "
+                                                      r"in step, given array\(\[nan" % os.getpid()):
+            vector.step(np.stack([np.array([math.nan, 0.0], np.float32), good]))
+        obs, _, _, _, infos = vector.step(np.stack([good, good]))
+        assert infos["sim_time"][1] - infos["sim_time"][0] == pytest.approx(0.1)
+        assert vector.call("dt") == (0.1, 0.1)
     finally:
         vector.close()
     assert_gone(vector)
