@@ -10,7 +10,9 @@ Prints progress every --report-every timesteps (episodes, mean return and length
 per second, time left); writes OUT/policy.npz, OUT/learning_curve.png, OUT/model.zip (the
 SB3 model, to go on training) and OUT/N.monitor.csv (one row per episode per environment).
 Observations are multiplied by 1/10 before the network (obs_scale in the .npz), so the
-network sees values in [0, 1].
+network sees values in [0, 1]. With --envs > 1 the environments run in worker processes of
+m2wr_gym's shared-memory vector env (sb3_vector.py; the same episodes and results as SB3's
+SubprocVecEnv, which --vec-env subproc picks).
 """
 import argparse
 import csv
