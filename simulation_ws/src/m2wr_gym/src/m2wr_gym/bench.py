@@ -10,7 +10,8 @@
    actions drawn ahead, so no sampler runs in the timed loops) stepped in this process one
    after the other, in one subprocess (an AsyncVectorEnv of one), in two subprocesses at
    once (AsyncVectorEnv of two), in m2wr_gym's SharedMemoryVectorEnv of one and of two
-   (shared_vector.py: shared arrays and semaphores instead of pipes), and through
+   (shared_vector.py: shared arrays and semaphores instead of pipes; of two also with
+   local=True, this process stepping one of them itself), and through
    stable-baselines3's SubprocVecEnv when it is installed; env steps per second of wall
    time, each ratio taken within the round. The machine's own ceiling for two processes
    is measured in the same round: two bare Bullet steppers in two processes at once
@@ -463,7 +464,8 @@ def vector_round(r, steps, with_sb3):
             ("1 subprocess", lambda: in_subprocesses(work, 1)),
             ("2 subprocesses", lambda: in_subprocesses(work, 2)),
             ("1 shm subprocess", lambda: in_subprocesses(work, 1, "shm")),
-            ("2 shm subprocesses", lambda: in_subprocesses(work, 2, "shm"))]
+            ("2 shm subprocesses", lambda: in_subprocesses(work, 2, "shm")),
+            ("2 shm, 1 local", lambda: in_subprocesses(work, 2, "shm", local=True))]
     if with_sb3:
         runs.append(("2 SB3 subprocesses", lambda: in_subprocesses(work, 2, "sb3")))
     runs += [("bare Bullet", lambda: bare_bullet(seconds)[0]),
@@ -478,8 +480,10 @@ def print_vector_round(r, rounds, f):
             "2 subprocesses %.0f (%.2fx in process, %.2fx 1 subprocess)"
             % (r + 1, rounds, one, sub, two, two / one, two / sub))
     shm1, shm2 = f["1 shm subprocess"]["rate"], f["2 shm subprocesses"]["rate"]
+    local = f["2 shm, 1 local"]["rate"]
     line += ("; shared-memory vector env: 1 subprocess %.0f, 2 subprocesses %.0f (%.2fx in "
-             "process, %.2fx its 1)" % (shm1, shm2, shm2 / one, shm2 / shm1))
+             "process, %.2fx its 1), 2 with local=True %.0f (%.2fx in process)"
+             % (shm1, shm2, shm2 / one, shm2 / shm1, local, local / one))
     if "2 SB3 subprocesses" in f:
         sb3 = f["2 SB3 subprocesses"]["rate"]
         line += ", 2 SB3 subprocesses %.0f (%.2fx in process)" % (sb3, sb3 / one)
@@ -497,7 +501,7 @@ def print_vector_summary(rounds, steps):
 
     ratio = {}
     for key in ("1 subprocess", "2 subprocesses", "1 shm subprocess", "2 shm subprocesses",
-                "2 SB3 subprocesses"):
+                "2 shm, 1 local", "2 SB3 subprocesses"):
         if key in rounds[0]:
             ratio[key] = [f[key]["rate"] / f["in process"]["rate"] for f in rounds]
     two_to_one = [f["2 subprocesses"]["rate"] / f["1 subprocess"]["rate"] for f in rounds]
@@ -510,6 +514,7 @@ def print_vector_summary(rounds, steps):
                        ("2 subprocesses", "two envs in subprocesses:"),
                        ("1 shm subprocess", "one in m2wr_gym's shared-memory env:"),
                        ("2 shm subprocesses", "two in m2wr_gym's shared-memory env:"),
+                       ("2 shm, 1 local", "the same, local=True (one in this process):"),
                        ("2 SB3 subprocesses", "two in SB3 SubprocVecEnv:")):
         if key in ratio:
             print("  %-38s %6.0f env steps/s = %.2fx in process (%s)"
