@@ -514,7 +514,7 @@ def print_vector_summary(rounds, steps):
                        ("2 subprocesses", "two envs in subprocesses:"),
                        ("1 shm subprocess", "one in m2wr_gym's shared-memory env:"),
                        ("2 shm subprocesses", "two in m2wr_gym's shared-memory env:"),
-                       ("2 shm, 1 local", "the same, local=True (one in this process):"),
+                       ("2 shm, 1 local", "two in it, local=True (1 here):"),
                        ("2 SB3 subprocesses", "two in SB3 SubprocVecEnv:")):
         if key in ratio:
             print("  %-38s %6.0f env steps/s = %.2fx in process (%s)"
