@@ -14,9 +14,10 @@ on request; metadata["autoreset_mode"] says which). The difference is the way th
 
 - Actions, observations, rewards and the terminated/truncated flags live in shared arrays;
   the numeric entries of each info (float, int, bool, numpy scalars, tuples of floats, such
-  as m2wr's sim_time, x, y, yaw, nearest, distance, command) in shared slots. A step is: the
-  learner writes the actions and posts each worker's "go" semaphore, each worker steps and
-  posts its "done" semaphore. No pickling and no pipe on that path.
+  as m2wr's sim_time, x, y, yaw, nearest, distance, command) in shared slots
+  (info_slots.py). A step is: the learner writes the actions and posts each worker's "go"
+  semaphore, each worker steps and posts its "done" semaphore. No pickling and no pipe on
+  that path.
 - Each worker also has a pipe, used only when something is rare: reset (seeds, options),
   call / get_attr / set_attr, close, and from the worker: an info whose keys or kinds
   changed, info values that do not fit a slot (touched model names, final_obs/final_info
@@ -49,9 +50,10 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import CloudpickleWrapper, batch_space
 
+from .info_slots import MAX_SLOTS, decode_info, encode_info, merge_plan, merge_same_layout
+
 __all__ = ["SharedMemoryVectorEnv", "SubEnvironmentError", "WorkerDiedError"]
 
-MAX_SLOTS = 32           # numeric info slots per worker; more go through the pipe
 LIVENESS = 0.2           # [s] between checks that a waited-for worker is still alive
 CLOSE_JOIN = 5.0         # [s] a worker is given to exit after "close" before terminate
 
@@ -103,104 +105,6 @@ def _fixed_shape_space(space, what):
                          "MultiBinary %s space (fixed shape and dtype); got %r: use "
                          "gymnasium.vector.AsyncVectorEnv for this environment" % (what, space))
     return space
-
-
-# --- info encoding: numeric values in slots, the rest through the pipe ----------------------
-_EXACT_IN_FLOAT64 = {np.dtype(t).str for t in (np.float16, np.float32, np.float64, np.int8,
-                                                 np.int16, np.int32, np.uint8, np.uint16,
-                                                 np.uint32, np.bool_)}
-
-
-def _encode_info(info, slots):
-    """(layout, extras): layout is a tuple of (key, kind, width), one per key in the info's
-    order, kind "float", "int", "bool", a numpy dtype string, "tuple" (of Python floats,
-    width = length) or "extra" (the value is in extras, to be pickled); the numeric values are
-    written into `slots` (a float64 row) in layout order, each exact."""
-    layout, extras, used = [], None, 0
-    for key, value in info.items():
-        kind, width = "extra", 0
-        t = type(value)
-        if t is float:
-            kind, width = "float", 1
-        elif t is bool:
-            kind, width = "bool", 1
-        elif t is int:
-            if -2 ** 53 <= value <= 2 ** 53:
-                kind, width = "int", 1
-        elif t is tuple:
-            if all(type(v) is float for v in value):
-                kind, width = "tuple", len(value)
-        elif isinstance(value, np.generic) and value.dtype.str in _EXACT_IN_FLOAT64:
-            kind, width = value.dtype.str, 1
-        if kind != "extra" and used + width > MAX_SLOTS:
-            kind, width = "extra", 0
-        if kind == "extra":
-            if extras is None:
-                extras = {}
-            extras[key] = value
-        elif width == 1:
-            slots[used] = value
-        elif width:
-            slots[used:used + width] = value
-        used += width
-        layout.append((key, kind, width))
-    return tuple(layout), extras
-
-
-def _decode_info(layout, slots, extras):
-    """The info dict _encode_info was given: same keys in the same order, same types."""
-    info, at = {}, 0
-    for key, kind, width in layout:
-        if kind == "float":
-            info[key] = float(slots[at])
-        elif kind == "int":
-            info[key] = int(slots[at])
-        elif kind == "bool":
-            info[key] = bool(slots[at])
-        elif kind == "tuple":
-            info[key] = tuple(slots[at:at + width].tolist())
-        elif kind == "extra":
-            info[key] = extras[key]
-        else:
-            info[key] = np.dtype(kind).type(slots[at])
-        at += width
-    return info
-
-
-_ARRAY_DTYPE = {"float": np.dtype(float), "int": np.dtype(int), "bool": np.dtype(np.bool_)}
-
-
-def _merge_plan(layout):
-    """For _merge_same_layout: (key, "_" + key, kind's array dtype or None for a tuple,
-    first slot, width) per key, and the slots used."""
-    plan, at = [], 0
-    for key, kind, width in layout:
-        dtype = None if kind == "tuple" else _ARRAY_DTYPE.get(kind) or np.dtype(kind)
-        plan.append((key, "_" + key, dtype, at, width))
-        at += width
-    return tuple(plan), at
-
-
-def _merge_same_layout(plan, used, slots):
-    """The merged infos AsyncVectorEnv builds (gymnasium's VectorEnv._add_info) when every
-    sub-environment's info has the same layout and no extras: one array per key, in key
-    order, each followed by its all-True mask. (One copy of the slots, then rows of it.)"""
-    n = slots.shape[0]
-    columns = slots[:, :used].T.copy()
-    masks = np.ones((len(plan), n), dtype=np.bool_)
-    infos = {}
-    for k, (key, mask_key, dtype, at, width) in enumerate(plan):
-        if dtype is None:
-            array = np.empty(n, dtype=object)
-            for i, row in enumerate(columns[at:at + width].T.tolist()):
-                array[i] = tuple(row)
-        elif dtype.char == "d":
-            array = columns[at]
-        else:
-            array = columns[at].astype(dtype)
-        infos[key] = array
-        infos[mask_key] = masks[k]
-    return infos
 
 
 # --- the worker ----------------------------------------------------------------------------
@@ -255,13 +159,13 @@ class _Runner:
         self.terminations[i] = terminated
         self.truncations[i] = truncated
         self.observations[i] = observation
-        return _encode_info(info, self.row)
+        return encode_info(info, self.row)
 
     def reset(self, kwargs):
         observation, info = self.env.reset(**kwargs)
         self.autoreset = False
         self.observations[self.index] = observation
-        return _encode_info(info, self.row)
+        return encode_info(info, self.row)
 
 
 def _given(call, action, kwargs):
@@ -597,18 +501,18 @@ class SharedMemoryVectorEnv(VectorEnv):
                        "wake": 0.0}
 
     def _info_list(self, which):
-        return [_decode_info(self._layouts[i], self._slots[i], self._extras[i]) for i in which]
+        return [decode_info(self._layouts[i], self._slots[i], self._extras[i]) for i in which]
 
     def _infos(self, which):
         layouts = [self._layouts[i] for i in which]
         if (len(which) == self.num_envs and all(l is layouts[0] or l == layouts[0] for l in layouts)
                 and all(self._extras[i] is None for i in which)):
             if self._plan is None or self._plan[0] != layouts[0]:
-                self._plan = (layouts[0],) + _merge_plan(layouts[0])
-            return _merge_same_layout(self._plan[1], self._plan[2], self._slots)
+                self._plan = (layouts[0],) + merge_plan(layouts[0])
+            return merge_same_layout(self._plan[1], self._plan[2], self._slots)
         infos = {}
         for i in which:
-            infos = self._add_info(infos, _decode_info(self._layouts[i], self._slots[i],
+            infos = self._add_info(infos, decode_info(self._layouts[i], self._slots[i],
                                                        self._extras[i]), i)
         return infos
 

@@ -13,8 +13,8 @@ import pytest
 from gymnasium.vector import AsyncVectorEnv, AutoresetMode
 
 from m2wr_gym.actions import InvalidAction
-from m2wr_gym.shared_vector import (SharedMemoryVectorEnv, SubEnvironmentError,
-                                    WorkerDiedError, _decode_info, _encode_info, MAX_SLOTS)
+from m2wr_gym.info_slots import MAX_SLOTS, decode_info, encode_info
+from m2wr_gym.shared_vector import SharedMemoryVectorEnv, SubEnvironmentError, WorkerDiedError
 
 # 1 s episodes (10 steps): 25 steps see two autoresets
 KWARGS = dict(start="random", observation="scan", downsample=4, action="continuous",
@@ -223,9 +223,9 @@ def test_info_encoding_round_trip_keeps_types_and_order():
             "command": (0.1, -0.2), "none": (), "touched": ("wall_1", "box"),
             "final_info": {"x": 1.0}, "big": 2 ** 60, "inf": math.inf}
     slots = np.zeros(MAX_SLOTS)
-    layout, extras = _encode_info(info, slots)
+    layout, extras = encode_info(info, slots)
     assert set(extras) == {"touched", "final_info", "big"}      # the rest went into slots
-    back = _decode_info(layout, slots, extras)
+    back = decode_info(layout, slots, extras)
     assert list(back) == list(info)
     for key, value in info.items():
         assert type(back[key]) is type(value) and back[key] == value, key
