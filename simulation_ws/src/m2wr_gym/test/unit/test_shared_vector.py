@@ -104,7 +104,8 @@ def test_same_observations_as_in_process_envs():
         for step, action in enumerate(actions, 1):
             obs, reward, terminated, truncated, info = env.step(action[k])
             assert np.array_equal(ours[step][0][k], obs) and ours[step][1][k] == reward
-            assert ours[step][4]["x"][k] == info["x"] and ours[step][4]["command"][k] == info["command"]
+            merged = ours[step][4]
+            assert merged["x"][k] == info["x"] and merged["command"][k] == info["command"]
         env.close()
 
 
