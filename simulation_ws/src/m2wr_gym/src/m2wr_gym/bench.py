@@ -36,7 +36,6 @@ than wall time (but still: note the load, `uptime`, with any figure).
 import argparse
 import contextlib
 import multiprocessing
-import signal
 import time
 import warnings
 
@@ -47,7 +46,7 @@ from gymnasium.vector import AsyncVectorEnv
 from m2wr_tools.processes import cpu_seconds
 
 from . import actions
-from .shared_vector import SharedMemoryVectorEnv
+from .shared_vector import SharedMemoryVectorEnv, children_ignore_ctrl_c
 
 KWARGS = dict(world="world02", start="random", observation="scan", action="continuous",
               control_rate=10.0, max_episode_seconds=120.0, end_on_contact=False)
@@ -83,18 +82,6 @@ def _bare_bullet_worker(seconds, start, results):
 def _free_env_worker(stretch, start, results):
     f = in_process([stretch], start)
     results.put((f["steps"], f["first"], f["last"], f["cpu"]))
-
-
-@contextlib.contextmanager
-def children_ignore_ctrl_c():
-    """Processes started inside have SIGINT blocked for good (they inherit the signal mask),
-    so a Ctrl-C reaches this process alone, which then closes them and no worker prints a
-    traceback; a Ctrl-C pressed meanwhile is delivered here as the block ends."""
-    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 def _two_at_once(target, args):
@@ -195,21 +182,6 @@ def env_against_bare(steps):
     env_sim, bare_sim = env_steps * dt, bare_steps * sim.physics_step
     return (env_sim / env_wall, env_steps / env_wall, env_sim / env_cpu,
             bare_sim / bare_wall, bare_sim / bare_cpu)
-
-
-def one_env(steps, seed=0):
-    env = make()
-    actions_ahead = drawn_actions(env, steps, seed)
-    env.reset(seed=seed)
-    started, cpu_started = time.perf_counter(), time.process_time()
-    for action in actions_ahead:
-        _, _, terminated, truncated, _ = env.step(action)
-        if terminated or truncated:
-            env.reset()
-    wall, cpu = time.perf_counter() - started, time.process_time() - cpu_started
-    dt = env.unwrapped.dt
-    env.close()
-    return steps * dt / wall, steps / wall, steps * dt / cpu
 
 
 @contextlib.contextmanager

@@ -38,6 +38,7 @@ on request; metadata["autoreset_mode"] says which). The difference is the way th
   by default: on a 2-core machine shared with other programs both lost (see the README).
 - timing_report(): the measured wake-ups and the workers' step times, [us] per step.
 """
+import contextlib
 import ctypes
 import multiprocessing
 import os
@@ -52,7 +53,7 @@ from gymnasium.vector.utils import CloudpickleWrapper, batch_space
 
 from .info_slots import MAX_SLOTS, decode_info, encode_info, merge_plan, merge_same_layout
 
-__all__ = ["SharedMemoryVectorEnv", "SubEnvironmentError", "WorkerDiedError"]
+__all__ = ["SharedMemoryVectorEnv", "SubEnvironmentError", "WorkerDiedError", "children_ignore_ctrl_c"]
 
 LIVENESS = 0.2           # [s] between checks that a waited-for worker is still alive
 CLOSE_JOIN = 5.0         # [s] a worker is given to exit after "close" before terminate
@@ -62,6 +63,18 @@ STEP, MESSAGE = 0, 1
 # status (worker -> learner), in shared memory: the step's results are all in the shared
 # arrays, or a pipe message follows
 PLAIN, FOLLOWS = 0, 1
+
+
+@contextlib.contextmanager
+def children_ignore_ctrl_c():
+    """Processes started inside have SIGINT blocked for good (they inherit the signal mask),
+    so a Ctrl-C reaches this process alone, which then closes them and no worker prints a
+    traceback; a Ctrl-C pressed meanwhile is delivered here as the block ends."""
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 class SubEnvironmentError(RuntimeError):
@@ -333,8 +346,7 @@ class SharedMemoryVectorEnv(VectorEnv):
         self.reset_timing()
         cores = sorted(os.sched_getaffinity(0))
         try:
-            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})   # inherited by workers
-            try:
+            with children_ignore_ctrl_c():
                 for i in self._workers:
                     env_fn = self.env_fns[i]
                     parent_pipe, child_pipe = ctx.Pipe()
@@ -348,8 +360,6 @@ class SharedMemoryVectorEnv(VectorEnv):
                     child_pipe.close()
                     self.processes.append(process)
                     self._process[i], self._pipes[i] = process, parent_pipe
-            finally:
-                signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
             for i in self._workers:
                 kind, payload = self._receive(i, "start")
                 if kind == "error":

@@ -95,7 +95,7 @@ class World:
     # --- time ---------------------------------------------------------------------------
     @property
     def sim_time(self) -> float:
-        return self._time_before + (self.step_count - self._steps_before) * self.step_size
+        return self._time_at(self.step_count)
 
     def sim_time_ns(self) -> int:
         """Sim time in integer nanoseconds: exact, never drifts over millions of steps."""
@@ -126,15 +126,20 @@ class World:
                     self.client.changeDynamics(
                         body, -1, activationState=pybullet.ACTIVATION_STATE_WAKE_UP)
 
+    def _time_at(self, count: int) -> float:
+        """Sim time [s] at step count `count` of the present step size (as sim_time reads
+        it then, to the last bit)."""
+        return self._time_before + (count - self._steps_before) * self.step_size
+
     def time_after(self, steps: int) -> float:
         """Sim time [s] after `steps` more physics steps of the present size (as sim_time will
         then read, to the last bit)."""
-        return self._time_before + (self.step_count + steps - self._steps_before) * self.step_size
+        return self._time_at(self.step_count + steps)
 
     def times_after(self, steps: int) -> List[float]:
         """[time_after(1), ..., time_after(steps)], to the last bit."""
-        base, done, size = self._time_before, self.step_count - self._steps_before, self.step_size
-        return [base + (done + k) * size for k in range(1, steps + 1)]
+        at, count = self._time_at, self.step_count
+        return [at(count + k) for k in range(1, steps + 1)]
 
     def step(self, collect=True) -> List[Reading]:
         """Advances physics by one fixed step; returns the parts' readings now due. `collect`:
@@ -254,12 +259,11 @@ class World:
         """Skips the readings due at the k - 1 sim times inside the stretch of k steps that
         began at step count `start`, as single steps would have: in step order, and at
         each time in the parts' order. `inside`: _readings_inside's answer for it."""
-        size, before, time_before = self.step_size, self._steps_before, self._time_before
         skippers = [part for part, _ in inside]
         due_at = [due for _, due in inside]
         first = min(due_at)
         for count in range(start + 1, start + k):
-            now = time_before + (count - before) * size      # as sim_time reads it
+            now = self._time_at(count)
             if now < first:
                 continue
             for index, part in enumerate(skippers):
@@ -287,17 +291,16 @@ class World:
         else:
             collect, skipped_until = skipped
             for _, part in self._stepped[0]:
-                if part not in collect:
-                    skippers.append(part)
-                    quiet = min(quiet, part.next_hook_time(now))
-                elif self.step_count < skipped_until:
+                collected = part in collect
+                if collected and self.step_count >= skipped_until:
+                    quiet = min(quiet, part.next_activity_time(now))    # its next is read
+                    continue
+                skippers.append(part)
+                quiet = min(quiet, part.next_hook_time(now))
+                if collected:
                     # skipped up to step count skipped_until, collected after it: the
                     # stretch may hold those skipped, and end on the first collected one
-                    skippers.append(part)
-                    quiet = min(quiet, part.next_hook_time(now))
                     k = min(k, skipped_until - self.step_count + 1)
-                else:
-                    quiet = min(quiet, part.next_activity_time(now))
         # k steps may run when the k - 1 sim times between them come before `quiet`
         if quiet < math.inf:
             k = min(k, max(1, int((quiet - now) / self.step_size) + 2))
