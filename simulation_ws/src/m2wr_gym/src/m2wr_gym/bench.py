@@ -10,8 +10,9 @@
    actions drawn ahead, so no sampler runs in the timed loops) stepped in this process one
    after the other, in one subprocess (an AsyncVectorEnv of one), in two subprocesses at
    once (AsyncVectorEnv of two), in m2wr_gym's SharedMemoryVectorEnv of one and of two
-   (shared_vector.py: shared arrays and semaphores instead of pipes; of two also with
-   local=True, this process stepping one of them itself), and through
+   (shared_vector.py: shared arrays and semaphores instead of pipes, workers that run
+   the physics no action can change while they wait; of two also without that,
+   run_ahead=False, and with local=True, this process stepping one of them itself), and through
    stable-baselines3's SubprocVecEnv when it is installed; env steps per second of wall
    time, each ratio taken within the round. The machine's own ceiling for two processes
    is measured in the same round: two bare Bullet steppers in two processes at once
@@ -437,6 +438,7 @@ def vector_round(r, steps, with_sb3):
             ("2 subprocesses", lambda: in_subprocesses(work, 2)),
             ("1 shm subprocess", lambda: in_subprocesses(work, 1, "shm")),
             ("2 shm subprocesses", lambda: in_subprocesses(work, 2, "shm")),
+            ("2 shm, no run-ahead", lambda: in_subprocesses(work, 2, "shm", run_ahead=False)),
             ("2 shm, 1 local", lambda: in_subprocesses(work, 2, "shm", local=True))]
     if with_sb3:
         runs.append(("2 SB3 subprocesses", lambda: in_subprocesses(work, 2, "sb3")))
@@ -452,10 +454,10 @@ def print_vector_round(r, rounds, f):
             "2 subprocesses %.0f (%.2fx in process, %.2fx 1 subprocess)"
             % (r + 1, rounds, one, sub, two, two / one, two / sub))
     shm1, shm2 = f["1 shm subprocess"]["rate"], f["2 shm subprocesses"]["rate"]
-    local = f["2 shm, 1 local"]["rate"]
+    local, plain = f["2 shm, 1 local"]["rate"], f["2 shm, no run-ahead"]["rate"]
     line += ("; shared-memory vector env: 1 subprocess %.0f, 2 subprocesses %.0f (%.2fx in "
-             "process, %.2fx its 1), 2 with local=True %.0f (%.2fx in process)"
-             % (shm1, shm2, shm2 / one, shm2 / shm1, local, local / one))
+             "process, %.2fx its 1; %.2fx without run-ahead), 2 with local=True %.0f (%.2fx in "
+             "process)" % (shm1, shm2, shm2 / one, shm2 / shm1, plain / one, local, local / one))
     if "2 SB3 subprocesses" in f:
         sb3 = f["2 SB3 subprocesses"]["rate"]
         line += ", 2 SB3 subprocesses %.0f (%.2fx in process)" % (sb3, sb3 / one)
@@ -473,7 +475,7 @@ def print_vector_summary(rounds, steps):
 
     ratio = {}
     for key in ("1 subprocess", "2 subprocesses", "1 shm subprocess", "2 shm subprocesses",
-                "2 shm, 1 local", "2 SB3 subprocesses"):
+                "2 shm, no run-ahead", "2 shm, 1 local", "2 SB3 subprocesses"):
         if key in rounds[0]:
             ratio[key] = [f[key]["rate"] / f["in process"]["rate"] for f in rounds]
     two_to_one = [f["2 subprocesses"]["rate"] / f["1 subprocess"]["rate"] for f in rounds]
@@ -486,6 +488,7 @@ def print_vector_summary(rounds, steps):
                        ("2 subprocesses", "two envs in subprocesses:"),
                        ("1 shm subprocess", "one in m2wr_gym's shared-memory env:"),
                        ("2 shm subprocesses", "two in m2wr_gym's shared-memory env:"),
+                       ("2 shm, no run-ahead", "two in it, run_ahead=False:"),
                        ("2 shm, 1 local", "two in it, local=True (1 here):"),
                        ("2 SB3 subprocesses", "two in SB3 SubprocVecEnv:")):
         if key in ratio:
@@ -544,10 +547,12 @@ def print_vector_summary(rounds, steps):
              median([t["worker cpu"] for t in two]) / inproc,
              median([t["main cpu"] for t in one_shm]) * 1e6,
              median([t["main cpu"] for t in two]) * 1e6, median([t["wall"] for t in two]) * 1e6))
-    print("  shared-memory env, two at once: a worker's step %.0f us (timed inside it), "
-          "wake-ups: learner's post -> worker running %.0f us, last worker's post -> learner "
-          "running %.0f us; CPU bound as above %.2fx (%s)"
-          % (median([t["work"] for t in two]), median([t["go"] for t in two]),
+    print("  shared-memory env, two at once: a worker's step %.0f us (timed inside it; CPU "
+          "%.0f us, and %.0f us run ahead while waiting), learner's post -> worker running "
+          "%.0f us (its run-ahead's end, when later), last worker's post -> learner running "
+          "%.0f us; CPU bound as above %.2fx (%s)"
+          % (median([t["work"] for t in two]), median([t["work cpu"] for t in two]),
+             median([t["ahead cpu"] for t in two]), median([t["go"] for t in two]),
              median([t["wake"] for t in two]), median(shm_bound), spread(shm_bound)))
 
 

@@ -61,6 +61,7 @@ class M2wrEnv(gymnasium.Env):
         self.sim = self._make_backend()
         self._picture = None
         self._snapshot = None
+        self._ended = False
         self._goal = None
         self._path = None         # [(x, y, yaw)] of the episode, kept for rgb_array pictures only
         self._steps_per_action = options.steps_per_action
@@ -132,6 +133,7 @@ class M2wrEnv(gymnasium.Env):
         world_seed = int(rng.integers(2 ** 31 - 1))
         self._snapshot = self.sim.reset(*start, seed=world_seed)
         self._steps = 0
+        self._ended = False
         self._distance = 0.0
         if self.render_mode == "rgb_array":
             self._path = [(self._snapshot.x, self._snapshot.y, self._snapshot.yaw)]
@@ -159,6 +161,7 @@ class M2wrEnv(gymnasium.Env):
             LOG.error("m2wr_gym: %s; the episode is truncated (invalid_action='end')", err)
             info = self._info((0.0, 0.0))
             info["invalid_action"] = str(err)
+            self._ended = True
             return self._observe(), 0.0, False, True, info
         after = self.sim.run(command[0], command[1], steps=self._steps_per_action)
         self._snapshot = after
@@ -177,7 +180,17 @@ class M2wrEnv(gymnasium.Env):
         if terminated and touched and not options.end_on_contact:
             terminated = False
         truncated = not terminated and self._steps >= self.max_steps
+        self._ended = terminated or truncated
         return self._observe(), float(reward), terminated, truncated, self._info(command, nearest)
+
+    def run_ahead(self):
+        """Does now the part of the next step that no action can change (see
+        InProcessSim.run_ahead), so that step() has less left to do; what any call returns
+        stays exactly as it would have been. For a vector env's worker, in the time it would
+        otherwise wait for the learner's next actions. Nothing to do after an episode's
+        end, before the first reset, or with the ROS backend."""
+        if self._snapshot is not None and not self._ended and hasattr(self.sim, "run_ahead"):
+            self.sim.run_ahead(self._steps_per_action)
 
     def _observe(self):
         s = self._snapshot

@@ -17,7 +17,6 @@ Prints progress per run and a Markdown table; --csv writes one row per run.
 """
 import argparse
 import csv
-import math
 import os
 import statistics
 import sys

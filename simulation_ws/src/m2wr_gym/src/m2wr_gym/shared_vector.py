@@ -18,6 +18,11 @@ on request; metadata["autoreset_mode"] says which). The difference is the way th
   (info_slots.py). A step is: the learner writes the actions and posts each worker's "go"
   semaphore, each worker steps and posts its "done" semaphore. No pickling and no pipe on
   that path.
+- After answering a step or reset, a worker calls its environment's run_ahead() when it
+  has one (env.unwrapped.run_ahead; run_ahead=False: never): m2wr's runs the physics of the
+  next step that no action can change (up to its drive's next command reading), in the time
+  the worker would otherwise wait for the slower worker and the learner. What the next step
+  returns is unchanged to the bit. An error it raises is reported as the next step's.
 - Each worker also has a pipe, used only when something is rare: reset (seeds, options),
   call / get_attr / set_attr, close, and from the worker: an info whose keys or kinds
   changed, info values that do not fit a slot (touched model names, final_obs/final_info
@@ -188,7 +193,8 @@ def _given(call, action, kwargs):
     return "reset(%s)" % ", ".join("%s=%r" % item for item in kwargs.items())
 
 
-def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, spin, cpu):
+def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, spin, cpu,
+            run_ahead):
     signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})     # Ctrl-C is the learner's
     parent_pipe.close()
     learner = multiprocessing.parent_process()
@@ -208,6 +214,8 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, 
     now, cpu_now = time.perf_counter, time.thread_time
     pipe.send(("ready", None))
     sent_layout = None
+    ahead = getattr(env.unwrapped, "run_ahead", None) if run_ahead else None
+    ahead_error = None
     try:
         while True:
             _wait_go(go, spin, learner)
@@ -228,6 +236,8 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, 
                 if call == "step":
                     # (through the pipe: an action the shared array cannot hold as given)
                     action = runner.shared_action() if message is None else message[1]
+                    if ahead_error is not None:
+                        raise ahead_error
                     layout, extras = runner.step(action)
                 else:
                     layout, extras = runner.reset(message[1])
@@ -237,6 +247,8 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, 
                 pipe.send(("error", _error_payload(
                     err, call, _given(call, action, message and message[1]))))
                 continue
+            finally:
+                ahead_error = None
             clock[2] = now()
             clock[3] = cpu_now() - cpu_started
             if layout == sent_layout and extras is None:
@@ -247,6 +259,13 @@ def _worker(index, env_fn, pipe, parent_pipe, shared, go, done, autoreset_mode, 
                 done.release()
                 pipe.send(("info", None if layout == sent_layout else layout, extras))
                 sent_layout = layout
+            if ahead is not None:
+                cpu_started = cpu_now()
+                try:
+                    ahead()
+                except Exception as err:         # reported as the next step's error
+                    ahead_error = err
+                clock[4] = cpu_now() - cpu_started
     finally:
         env.close()
 
@@ -291,10 +310,13 @@ class SharedMemoryVectorEnv(VectorEnv):
     local: this (the learner's) process steps sub-environment 0 itself, while the workers
     step the others: one process fewer to wake and to schedule; errors, results and infos as
     with a worker (its "worker pid" is this process's).
-    copy: return copies of the observations (True), or the shared array itself."""
+    copy: return copies of the observations (True), or the shared array itself.
+    run_ahead: after each step or reset, a worker calls its environment's run_ahead() if it
+    has one (env.unwrapped.run_ahead: m2wr's runs the physics of the next step that no
+    action can change), while the learner and the other workers finish theirs."""
 
     def __init__(self, env_fns, autoreset_mode=AutoresetMode.NEXT_STEP, context=None,
-                 spin=0.0, pin=False, local=False, copy=True):
+                 spin=0.0, pin=False, local=False, copy=True, run_ahead=True):
         self.env_fns = list(env_fns)
         self.num_envs = len(self.env_fns)
         if self.num_envs < 1:
@@ -331,7 +353,7 @@ class SharedMemoryVectorEnv(VectorEnv):
                   _shared_array(ctx, np.int32, (n,)),
                   _shared_array(ctx, np.int32, (n,)),
                   _shared_array(ctx, np.float64, (n, MAX_SLOTS)),
-                  _shared_array(ctx, np.float64, (n, 4))]
+                  _shared_array(ctx, np.float64, (n, 5))]
         views = [_view(s) for s in shared]
         (self._actions, self._observations, self._rewards, self._terminations,
          self._truncations, self._command, self._status, self._slots, self._clock) = views
@@ -355,7 +377,7 @@ class SharedMemoryVectorEnv(VectorEnv):
                         target=_worker, name="SharedMemoryVectorEnv-%d" % i, daemon=True,
                         args=(i, CloudpickleWrapper(env_fn), child_pipe, parent_pipe, shared,
                               self._go[i], self._done[i], self.autoreset_mode,
-                              float(spin), cpu))
+                              float(spin), cpu, run_ahead))
                     process.start()
                     child_pipe.close()
                     self.processes.append(process)
@@ -485,30 +507,31 @@ class SharedMemoryVectorEnv(VectorEnv):
                 err, call, _given(call, action, message and message[1]))))
 
     def _time(self, which):
-        """Adds this step's waits to self.timing: [s] summed over steps (see timing_report)."""
+        """Adds this step's clocks to the sums timing_report reads (one numpy sum: this runs
+        on every step)."""
         returned = time.perf_counter()
-        clock, timing = self._clock, self.timing
-        timing["steps"] += 1
-        for i in which:
-            timing["go"] += clock[i, 1] - clock[i, 0]
-            timing["work"] += clock[i, 2] - clock[i, 1]
-            timing["work cpu"] += clock[i, 3]
-        timing["wake"] += returned - max(clock[i, 2] for i in which)
-        timing["envs"] += len(which)
+        clock = self._clock[which] if len(which) < self.num_envs else self._clock
+        self._clock_sums += clock.sum(axis=0)
+        self._wake_sum += returned - clock[:, 2].max()
+        self._timed_steps += 1
+        self._timed_envs += len(clock)
 
     def timing_report(self):
         """Mean [us] per step since construction (or the last reset_timing()): go = from
-        the learner's post to a worker running (wake-up); work = a worker's step, action read
-        to results written (its reset on autoreset included), "work cpu" the CPU time of that;
-        wake = from the last worker's post to the learner running again."""
-        t = self.timing
-        steps, envs = max(t["steps"], 1), max(t["envs"], 1)
-        return {"go": t["go"] / envs * 1e6, "work": t["work"] / envs * 1e6,
-                "work cpu": t["work cpu"] / envs * 1e6, "wake": t["wake"] / steps * 1e6}
+        the learner's post to a worker running (wake-up; the end of its run-ahead when that
+        is later); work = a worker's step, action read to results written (its reset on
+        autoreset included), "work cpu" the CPU time of that; "ahead cpu" the CPU time of
+        a worker's run-ahead; wake = from the last worker's post to the learner running."""
+        posted, running, finished, work_cpu, ahead_cpu = self._clock_sums
+        steps, envs = max(self._timed_steps, 1), max(self._timed_envs, 1)
+        return {"go": (running - posted) / envs * 1e6, "work": (finished - running) / envs * 1e6,
+                "work cpu": work_cpu / envs * 1e6, "ahead cpu": ahead_cpu / envs * 1e6,
+                "wake": self._wake_sum / steps * 1e6}
 
     def reset_timing(self):
-        self.timing = {"steps": 0, "envs": 0, "go": 0.0, "work": 0.0, "work cpu": 0.0,
-                       "wake": 0.0}
+        self._clock_sums = np.zeros(self._clock.shape[1])
+        self._wake_sum = 0.0
+        self._timed_steps = self._timed_envs = 0
 
     def _info_list(self, which):
         return [decode_info(self._layouts[i], self._slots[i], self._extras[i]) for i in which]

@@ -62,6 +62,7 @@ class InProcessSim:
         self._drive = None
         self._laser = None
         self._laser_last = None
+        self._ahead = None        # (steps, touched, readings) run_ahead did of the next run
 
     def reset(self, x, y, yaw, seed):
         """A fresh world with m2wr at (x, y, yaw) at rest; ValueError naming the pose when it
@@ -82,6 +83,7 @@ class InProcessSim:
         self._drive = drives[0]
         self._laser = lasers[0]
         self._laser_last = None
+        self._ahead = None
         entity = self.world.entity(ROBOT)
         # the model frame from Bullet's centre-of-mass pose, as World.model_pose computes it
         # (a robot's model frame is its root link's: no further offset)
@@ -97,17 +99,42 @@ class InProcessSim:
         wheels at the drive's next update (20 Hz for m2wr), as a cmd_vel would. Only the
         laser's last scan of these steps is observed, so only that one is cast: the scans
         before it and the other parts' readings are skipped (their schedules and noise draws
-        go on as if made)."""
+        go on as if made). The steps run_ahead ran already are not run again."""
+        ahead, touched, readings = self._ahead or (0, set(), [])
+        self._ahead = None
         self._drive.set_command(linear_x, angular_z)
-        world = self.world
-        scans = self._laser.scans_at(world.times_after(steps))
-        touched = set()
-        if scans:                                      # cast at the last, skip those before
-            readings = world.advance(steps, collect=(self._laser,), touched=touched,
-                                     collect_from=scans[-1])
-        else:
-            readings = world.advance(steps, collect=(), touched=touched)
+        if steps > ahead:
+            readings = readings + self._advance(steps - ahead, touched, continues=ahead > 0)
         return self._snapshot(readings, tuple(sorted({other for _, other in touched})))
+
+    def run_ahead(self, steps):
+        """Runs now the first steps of the next run(..., steps): those that start before the
+        drive next reads its command, which no command given meanwhile can change (the
+        drive keeps a command until its next update, as Gazebo's does). A vector env's
+        worker calls this while the learner chooses the next action; run() then does the
+        rest, with results identical to the bit to a run() without it. Not with a
+        commandTimeout (the command's arrival time would count): then nothing is run."""
+        if self._ahead is not None or self.world is None or self._drive.command_timeout > 0:
+            return
+        world = self.world
+        reads = world.next_command_time()
+        starts = [world.sim_time] + world.times_after(steps - 1)    # of the steps to run
+        count = steps if reads is None else sum(1 for t in starts if t < reads)
+        touched = set()
+        self._ahead = (count, touched, self._advance(count, touched, steps) if count else [])
+
+    def _advance(self, count, touched, window=None, continues=False):
+        """`count` physics steps of a window of `window` (default: `count`) that ends with
+        an observation: the laser's last scan in the window is collected if it falls in
+        these steps, every other reading is skipped. The contact guard looks over the whole
+        window; `continues`: these steps follow such a call's (World.advance)."""
+        world = self.world
+        window = window or count
+        scans = self._laser.scans_at(world.times_after(window))
+        last = scans[-1] if scans and scans[-1] < count else None
+        return world.advance(count, collect=() if last is None else (self._laser,),
+                             touched=touched, collect_from=last or 0, continues=continues,
+                             horizon=window)
 
     def _snapshot(self, readings, touched):
         for reading in readings:

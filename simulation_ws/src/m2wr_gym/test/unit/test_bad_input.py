@@ -1,7 +1,6 @@
 """Bad input gives a clear error naming it; with invalid_action='end' a vectorised run goes
 on past a bad action."""
 import math
-import os
 
 import gymnasium
 import numpy as np

@@ -300,3 +300,52 @@ def test_an_error_in_the_learners_own_sub_environment_is_named_too():
     finally:
         vector.close()
     assert_gone(vector)
+
+
+def physics_lead(env):
+    """[physics steps] the world has run past what the last step returned."""
+    sim = env.unwrapped.sim
+    return sim.world.step_count - round(env.unwrapped._snapshot.sim_time / sim.physics_step)
+
+
+def make_with_a_failing_run_ahead():
+    """An env whose run_ahead raises on its second call (the one after the first step)."""
+    env = make()
+    calls = []
+
+    def run_ahead():
+        calls.append(None)
+        if len(calls) == 2:
+            raise RuntimeError("run_ahead broke on purpose")
+    env.unwrapped.run_ahead = run_ahead
+    return env
+
+
+def test_workers_run_ahead_while_the_learner_waits_and_its_errors_are_named():
+    vector = SharedMemoryVectorEnv([make, make])
+    plain = SharedMemoryVectorEnv([make, make], run_ahead=False)
+    try:
+        vector.reset(seed=1)
+        plain.reset(seed=1)
+        action = np.array([[0.4, 0.2], [0.2, -0.5]], np.float32)
+        for _ in range(3):
+            ours, theirs = vector.step(action), plain.step(action)
+            assert_same(theirs, ours, "step")
+        assert vector.apply(physics_lead) == (9, 9)   # up to the drive's next update
+        assert plain.apply(physics_lead) == (0, 0)
+    finally:
+        vector.close()
+        plain.close()
+    vector = SharedMemoryVectorEnv([make, make_with_a_failing_run_ahead])
+    try:
+        vector.reset(seed=0)
+        zeros = np.zeros((2, 2), np.float32)
+        vector.step(zeros)                           # its run_ahead fails after this step
+        with pytest.raises(SubEnvironmentError, match=r"sub-environment 1 .*RuntimeError in "
+                                                      r"step.*run_ahead broke on purpose"):
+            vector.step(zeros)
+        obs, *_ = vector.step(zeros)                  # and it goes on
+        assert obs.shape == (2, 180)
+    finally:
+        vector.close()
+    assert_gone(vector)

@@ -484,3 +484,55 @@ def test_touching_at_the_end_of_a_call_then_moved_away_batches_again(make_world,
     assert not any(touched for _, _, touched in trace[30:])
     assert marks["pressed"] > 20 * 5              # the last commands on the barrier: singles
     assert calls.calls - marks["open"] == 8 * 3   # in the open: 1 + 10 + 9 per command
+
+
+def test_a_call_that_continues_another_keeps_the_guards_answer_and_stays_identical(
+        make_world, world02, m2wr_urdf):
+    """Each 20 steps as 9 (the guard looking over all 20), the next command, then 11 with
+    continues=True (as m2wr_gym's run_ahead does): bit for bit single stepping with the
+    command given at the same step, contact events included; the guard asked no more often
+    than by calls of 20 (in the open); and a teleport between the two calls makes a fresh start all the
+    same: m2wr backs away from row A in the open, is put 1 cm from its face heading in,
+    and drives into it."""
+    near = Pose.from_xyz_rpy(0, 5.545, 0.1, 0, 0, -math.pi / 2)
+    commands = [(-0.3, 0.0)] * 8 + [(0.4, 0.0)] * 12
+    runs = {}
+    for way in ("single", "split", "whole"):
+        world = make_world(world02)
+        robot = world.spawn_urdf("m2wr", m2wr_urdf, FACING_ROW_A)
+        drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
+        asked = []
+        safe_time = world._batcher.safe_time
+        world._batcher.safe_time = lambda *a, **k: asked.append(1) or safe_time(*a, **k)
+        trace = []
+        for index, command in enumerate(commands):
+            touched = set()
+            if index == 8:
+                asked_in_the_open = len(asked)
+            if way == "whole":
+                if index == 8:
+                    world.set_model_state("m2wr", near)
+                drive_part.set_command(*command)
+                readings = world.advance(CONTROL, touched=touched)
+            elif way == "split":
+                readings = world.advance(9, touched=touched, horizon=CONTROL)
+                if index == 8:
+                    world.set_model_state("m2wr", near)
+                drive_part.set_command(*command)
+                readings += world.advance(CONTROL - 9, touched=touched, continues=True)
+            else:
+                readings = []
+                for step in range(CONTROL):
+                    if step == 9:
+                        if index == 8:
+                            world.set_model_state("m2wr", near)
+                        drive_part.set_command(*command)
+                    readings += world.step()
+                    touched.update(world.touching())
+            trace.append((state(world, robot), readings_record(readings), sorted(touched)))
+        runs[way] = trace, list(world.contact_events), asked_in_the_open
+    single, split, whole = runs["single"], runs["split"], runs["whole"]
+    assert split[:2] == single[:2]
+    events = single[1]
+    assert events and events[0].sim_time > 8 * CONTROL * STEP    # the touch after the teleport
+    assert 0 < split[2] <= whole[2]

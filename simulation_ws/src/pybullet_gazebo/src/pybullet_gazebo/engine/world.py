@@ -73,6 +73,8 @@ class World:
         self._single_until = -1     # step count before which advance steps one by one
         self._safe_until = -1       # step count up to which no contact can start
         self._read_at = -1          # step count at which the contacts were last read
+        self._guard_end = -1        # step count at which the last advance ended (-1: early)
+        self._horizon_end = 0       # step count up to which the guard looks in this call
         self._batcher = Batcher(client)
         self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
@@ -149,7 +151,7 @@ class World:
         return self.advance(1, collect)
 
     def advance(self, steps, collect=True, touched=None, until_news=False,
-                collect_from=0) -> List[Reading]:
+                collect_from=0, continues=False, horizon=None) -> List[Reading]:
         """`steps` fixed steps, with the same readings (`collect` as for step), contact events,
         sim time and physics, to the last bit, as `steps` calls of step(); stretches in which
         nothing can happen between steps (no part's hook acts, no wrench, no contact can
@@ -160,14 +162,24 @@ class World:
         how many steps ran). `collect_from`: the readings due in the steps before this one
         (0: the first) are skipped whatever `collect` says (a caller that observes only the
         last of them). A reading that is skipped does not end a stretch (see
-        Part.next_reading_time), except with until_news."""
+        Part.next_reading_time), except with until_news. `continues`: this call goes on
+        from where the last one ended, with nothing changed in between but parts' commands
+        (a command is read by a part's hook, as within a call), so the contact guard's
+        answers from the last call still hold (otherwise they hold for one call).
+        (A teleport, spawn or delete since makes a fresh start all the same.)
+        `horizon`: how many steps from now the contact guard looks ahead (default `steps`):
+        a caller that will continue with another call asks for both at once."""
         if self._robots is None:
             self.robots()                   # refreshes the caches after a spawn or delete
         parts = self._stepped[0]
         readings = []
         left = steps
         skipped_until = self.step_count + collect_from   # step count after the last skipped
-        self._safe_until = self._single_until = -1     # the guard's answers hold for one call
+        if not (continues and self.step_count == self._guard_end
+                and self._settled == self.layout_version):
+            self._safe_until = self._single_until = -1     # the guard's answers: one call
+        self._guard_end = -1                            # (set again if this call ends well)
+        self._horizon_end = self.step_count + (steps if horizon is None else horizon)
         changes = self.contacts.changes if until_news else None
         # the readings skipped whatever their time: those of parts not collected, and those
         # due up to step count skipped_until (None: none is, or readings end stretches)
@@ -213,6 +225,7 @@ class World:
             self._settled = self.layout_version
             if changes is not None and (readings or self.contacts.changes != changes):
                 break
+        self._guard_end = self.step_count
         return readings
 
     def _steps_one_by_one(self, steps, touched, changes=None):
@@ -312,8 +325,9 @@ class World:
                 safe = 0.0                  # a robot touches a model now: no need to ask
             else:
                 robots, others, grounds = self._guarded
+                horizon = max(most, self._horizon_end - self.step_count)
                 safe = self._batcher.safe_time(robots, others, grounds,
-                                               most * self.step_size, self._statics)
+                                               horizon * self.step_size, self._statics)
             self._safe_until = self.step_count + int(safe / self.step_size)
             wanted, k = k, self._batcher.largest_exact(
                 self.step_size, min(k, self._safe_until - self.step_count))
