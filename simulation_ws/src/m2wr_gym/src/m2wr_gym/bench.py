@@ -262,35 +262,54 @@ def stretches(seed, steps):
 
 def in_process(work, start=None):
     """The stretches one after the other in this process: env steps/s of wall time and CPU
-    seconds per env step (timed steps only; also their number, and when the first timed
-    step started and the last ended, perf_counter). An episode's end is followed by a reset in
-    place of the next action, as AsyncVectorEnv's autoreset does."""
+    seconds per env step (timed steps only; also their number, when the first timed step
+    started and the last ended, perf_counter, and each timed step's CPU seconds, per
+    stretch). An episode's end is followed by a reset in place of the next action, as
+    AsyncVectorEnv's autoreset does."""
     env = make()
     if start is not None:
         start.wait()                       # a barrier: two_free_envs starts two at once
     wall = cpu = 0.0
     timed = 0
     first = None
+    step_cpu = []
+    thread_time = time.thread_time
     for seed, chosen in work:
         env.reset(seed=seed)
         ended = False
+        each = np.zeros(len(chosen))
         for i, action in enumerate(chosen):
             if i == WARMUP:
                 started, cpu_started = time.perf_counter(), time.process_time()
                 first = started if first is None else first
+            began = thread_time()
             if ended:
                 env.reset()
                 ended = False
-                continue
-            _, _, terminated, truncated, _ = env.step(action)
-            ended = terminated or truncated
+            else:
+                _, _, terminated, truncated, _ = env.step(action)
+                ended = terminated or truncated
+            each[i] = thread_time() - began
         last = time.perf_counter()
         wall += last - started
         cpu += time.process_time() - cpu_started
         timed += len(chosen) - WARMUP
+        step_cpu.append(each[WARMUP:])
     env.close()
     return {"rate": timed / wall, "cpu": cpu / timed, "steps": timed, "first": first,
-            "last": last}
+            "last": last, "step cpu": step_cpu}
+
+
+def lockstep_price(step_cpu):
+    """How much longer than an average step a vector env's step of two takes when the two
+    envs' steps (each stretch's k-th, paired as a vector env pairs them) cost what they
+    cost in process and the faster one waits for the slower: mean of the pairs' max / mean
+    of all. Step costs vary with what the robot meets (contacts stepped one step at a time,
+    Bullet's solver): the most a lockstep vector env of two can give is the two cores'
+    ceiling divided by this."""
+    a, b = step_cpu[:2]
+    n = min(len(a), len(b))
+    return float(np.maximum(a[:n], b[:n]).mean() / np.concatenate([a[:n], b[:n]]).mean())
 
 
 def in_subprocesses(work, parallel, library="gymnasium", **options):
@@ -510,6 +529,12 @@ def print_vector_summary(rounds, steps):
           "process (%s)" % (median(free), spread(free),
                             median([f["2 free envs"]["cpu"] for f in rounds]) * 1e6,
                             median(free_cpu), spread(free_cpu)))
+    price = [lockstep_price(f["in process"]["step cpu"]) for f in rounds]
+    bound = [c / p for c, p in zip(free, price)]
+    print("  lockstep's own price: the slower of the two envs' steps (paired as a vector env "
+          "pairs them, CPU measured in process) takes %.2fx the mean step (%s); so the most "
+          "any lockstep vector env of two could give here, the envs' ceiling / that: %.2fx "
+          "in process (%s)" % (median(price), spread(price), median(bound), spread(bound)))
     # CPU: what the two cores did per vector step of two envs, against its wall time
     inproc = median([f["in process"]["cpu"] for f in rounds])
     w1 = median([f["1 subprocess"]["worker cpu"] for f in rounds])
