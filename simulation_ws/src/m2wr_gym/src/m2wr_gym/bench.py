@@ -12,7 +12,8 @@
    once (AsyncVectorEnv of two), in m2wr_gym's SharedMemoryVectorEnv of one and of two
    (shared_vector.py: shared arrays and semaphores instead of pipes, workers that run
    the physics no action can change while they wait; of two also without that,
-   run_ahead=False, and with local=True, this process stepping one of them itself), and through
+   run_ahead=False, and with local=True, this process stepping one of them itself, also
+   with spin, both processes polling instead of sleeping), and through
    stable-baselines3's SubprocVecEnv when it is installed; env steps per second of wall
    time, each ratio taken within the round. The machine's own ceiling for two processes
    is measured in the same round: two bare Bullet steppers in two processes at once
@@ -244,6 +245,7 @@ def breakdown(steps, seed=0):
             "bullet calls": timers["physics"][1] / steps}
 
 
+LOCAL_SPIN = 0.002    # [s] SharedMemoryVectorEnv's spin in the local=True measurement
 WARMUP = 10          # env steps after each reset before timing (pages touched, caches filled)
 
 
@@ -458,7 +460,9 @@ def vector_round(r, steps, with_sb3):
             ("1 shm subprocess", lambda: in_subprocesses(work, 1, "shm")),
             ("2 shm subprocesses", lambda: in_subprocesses(work, 2, "shm")),
             ("2 shm, no run-ahead", lambda: in_subprocesses(work, 2, "shm", run_ahead=False)),
-            ("2 shm, 1 local", lambda: in_subprocesses(work, 2, "shm", local=True))]
+            ("2 shm, 1 local", lambda: in_subprocesses(work, 2, "shm", local=True)),
+            ("2 shm, 1 local, spin", lambda: in_subprocesses(work, 2, "shm", local=True,
+                                                             spin=LOCAL_SPIN))]
     if with_sb3:
         runs.append(("2 SB3 subprocesses", lambda: in_subprocesses(work, 2, "sb3")))
     runs += [("bare Bullet", lambda: bare_bullet(seconds)[0]),
@@ -474,9 +478,11 @@ def print_vector_round(r, rounds, f):
             % (r + 1, rounds, one, sub, two, two / one, two / sub))
     shm1, shm2 = f["1 shm subprocess"]["rate"], f["2 shm subprocesses"]["rate"]
     local, plain = f["2 shm, 1 local"]["rate"], f["2 shm, no run-ahead"]["rate"]
+    spinning = f["2 shm, 1 local, spin"]["rate"]
     line += ("; shared-memory vector env: 1 subprocess %.0f, 2 subprocesses %.0f (%.2fx in "
              "process, %.2fx its 1; %.2fx without run-ahead), 2 with local=True %.0f (%.2fx in "
-             "process)" % (shm1, shm2, shm2 / one, shm2 / shm1, plain / one, local, local / one))
+             "process; %.2fx spinning)" % (shm1, shm2, shm2 / one, shm2 / shm1, plain / one,
+                                           local, local / one, spinning / one))
     if "2 SB3 subprocesses" in f:
         sb3 = f["2 SB3 subprocesses"]["rate"]
         line += ", 2 SB3 subprocesses %.0f (%.2fx in process)" % (sb3, sb3 / one)
@@ -494,7 +500,8 @@ def print_vector_summary(rounds, steps):
 
     ratio = {}
     for key in ("1 subprocess", "2 subprocesses", "1 shm subprocess", "2 shm subprocesses",
-                "2 shm, no run-ahead", "2 shm, 1 local", "2 SB3 subprocesses"):
+                "2 shm, no run-ahead", "2 shm, 1 local", "2 shm, 1 local, spin",
+                "2 SB3 subprocesses"):
         if key in rounds[0]:
             ratio[key] = [f[key]["rate"] / f["in process"]["rate"] for f in rounds]
     two_to_one = [f["2 subprocesses"]["rate"] / f["1 subprocess"]["rate"] for f in rounds]
@@ -509,6 +516,7 @@ def print_vector_summary(rounds, steps):
                        ("2 shm subprocesses", "two in m2wr_gym's shared-memory env:"),
                        ("2 shm, no run-ahead", "two in it, run_ahead=False:"),
                        ("2 shm, 1 local", "two in it, local=True (1 here):"),
+                       ("2 shm, 1 local, spin", "the same, spin=%g s:" % LOCAL_SPIN),
                        ("2 SB3 subprocesses", "two in SB3 SubprocVecEnv:")):
         if key in ratio:
             print("  %-38s %6.0f env steps/s = %.2fx in process (%s)"

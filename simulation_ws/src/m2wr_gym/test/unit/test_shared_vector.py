@@ -64,15 +64,17 @@ def assert_same(a, b, where):
         assert type(a) is type(b) and (a == b or (a != a and b != b)), (where, a, b)
 
 
-@pytest.mark.parametrize("maker, mode, local", [(make, AutoresetMode.NEXT_STEP, False),
-                                                (make, AutoresetMode.SAME_STEP, False),
-                                                (make_discrete, AutoresetMode.NEXT_STEP, False),
-                                                (make, AutoresetMode.NEXT_STEP, True)])
-def test_same_results_as_async_vector_env(maker, mode, local):
-    """local: sub-environment 0 stepped in the learner's process."""
+@pytest.mark.parametrize("maker, mode, local, spin", [
+    (make, AutoresetMode.NEXT_STEP, False, 0.0),
+    (make, AutoresetMode.SAME_STEP, False, 0.0),
+    (make_discrete, AutoresetMode.NEXT_STEP, False, 0.0),
+    (make, AutoresetMode.NEXT_STEP, True, 0.0),
+    (make, AutoresetMode.SAME_STEP, True, 0.002)])
+def test_same_results_as_async_vector_env(maker, mode, local, spin):
+    """local: sub-environment 0 stepped in the learner's process; spin: both sides poll."""
     results = {}
     for cls in (AsyncVectorEnv, SharedMemoryVectorEnv):
-        options = {"local": local} if cls is SharedMemoryVectorEnv else {}
+        options = {"local": local, "spin": spin} if cls is SharedMemoryVectorEnv else {}
         vector = cls([maker, maker], autoreset_mode=mode, **options)
         try:
             actions = actions_for(vector.action_space, 25)
