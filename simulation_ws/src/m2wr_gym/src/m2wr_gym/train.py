@@ -13,7 +13,7 @@ Observations are multiplied by 1/10 before the network (obs_scale in the .npz), 
 network sees values in [0, 1]. With --envs > 1 the environments run in m2wr_gym's
 shared-memory vector env (sb3_vector.py; the same episodes and results as SB3's
 SubprocVecEnv, which --vec-env subproc picks): in worker processes, the first one in this
-process when there are no more environments than cores.
+process when there are no more environments than cores (--vec-env workers: all in workers).
 """
 import argparse
 import csv
@@ -34,8 +34,10 @@ def parse_args(argv=None):
     p.add_argument("--timesteps", type=int, default=300000, help="environment steps in all")
     p.add_argument("--envs", type=int, default=2, help="environments (1: in this process; "
                    "more: in workers, the first here when they fit the cores)")
-    p.add_argument("--vec-env", default="shared", choices=("shared", "subproc"),
-                   help="with --envs > 1: m2wr_gym's shared-memory vector env (sb3_vector.py) "
+    p.add_argument("--vec-env", default="shared", choices=("shared", "workers", "subproc"),
+                   help="with --envs > 1: m2wr_gym's shared-memory vector env (sb3_vector.py; "
+                        "the first env in this process when the envs fit the cores), the same "
+                        "with every env in a worker (on a machine busy with other programs), "
                         "or SB3's SubprocVecEnv")
     p.add_argument("--observation", default="regions", choices=("regions", "scan"))
     p.add_argument("--downsample", type=int, default=1)
@@ -164,13 +166,13 @@ def main(argv=None):
     builders = [make_env(kwargs, monitors[i]) for i in range(args.envs)]
     if args.envs == 1:
         venv = DummyVecEnv(builders)
-    elif args.vec_env == "shared":
+    elif args.vec_env in ("shared", "workers"):
         from .sb3_vector import SharedMemoryVecEnv
         # forkserver, as SubprocVecEnv: workers are not forks of a process running torch.
         # With no more envs than cores, this process steps the first env itself and both
         # sides poll rather than sleep (each has a core): 1.15x the throughput of envs all
-        # in workers here (README, Speed)
-        fits = args.envs <= len(os.sched_getaffinity(0))
+        # in workers on an idle machine, 0.93x with another program busy (README, Speed)
+        fits = args.vec_env == "shared" and args.envs <= len(os.sched_getaffinity(0))
         venv = SharedMemoryVecEnv(builders, context="forkserver", local=fits,
                                   spin=SPIN if fits else 0.0)
     else:
