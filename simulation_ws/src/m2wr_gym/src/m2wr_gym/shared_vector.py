@@ -127,19 +127,26 @@ def _fixed_shape_space(space, what):
     return space
 
 
-# --- the worker ----------------------------------------------------------------------------
-def _wait_go(go, spin, learner):
-    """Takes the "go" semaphore: tries without blocking for `spin` seconds (yielding the core
-    to any other runnable thread between tries), then blocks; exits if the learner (a
-    multiprocessing parent_process(), whatever the start method) is gone."""
+def _poll(semaphore, spin):
+    """Tries to take `semaphore` without blocking for up to `spin` seconds, yielding the
+    core to any other runnable thread between tries: True once taken, False at the end."""
     if spin > 0:
         deadline = time.perf_counter() + spin
         while True:
-            if go.acquire(False):
-                return
+            if semaphore.acquire(False):
+                return True
             if time.perf_counter() > deadline:
                 break
             os.sched_yield()
+    return False
+
+
+# --- the worker ----------------------------------------------------------------------------
+def _wait_go(go, spin, learner):
+    """Takes the "go" semaphore: polls for `spin` seconds (_poll), then blocks; exits if
+    the learner (a multiprocessing parent_process(), whatever the start method) is gone."""
+    if _poll(go, spin):
+        return
     while not go.acquire(True, 1.0):
         if learner is not None and not learner.is_alive():
             os._exit(0)                      # the learner died without closing us
@@ -413,14 +420,8 @@ class SharedMemoryVectorEnv(VectorEnv):
 
     def _wait_done(self, i, during):
         done, process = self._done[i], self._process[i]
-        if self.spin > 0:
-            deadline = time.perf_counter() + self.spin
-            while not done.acquire(False):
-                if time.perf_counter() > deadline:
-                    break
-                os.sched_yield()
-            else:
-                return
+        if _poll(done, self.spin):
+            return
         while not done.acquire(True, LIVENESS):
             if not process.is_alive():
                 raise self._died(i, during)

@@ -118,23 +118,26 @@ class InProcessSim:
             return
         world = self.world
         reads = world.next_command_time()
-        starts = [world.sim_time] + world.times_after(steps - 1)    # of the steps to run
+        times = world.times_after(steps)                 # at the end of each step to run
+        starts = [world.sim_time] + times[:-1]           # at the start of each
         count = steps if reads is None else sum(1 for t in starts if t < reads)
         touched = set()
-        self._ahead = (count, touched, self._advance(count, touched, steps) if count else [])
+        self._ahead = (count, touched, self._advance(count, touched, times) if count else [])
 
-    def _advance(self, count, touched, window=None, continues=False):
-        """`count` physics steps of a window of `window` (default: `count`) that ends with
-        an observation: the laser's last scan in the window is collected if it falls in
-        these steps, every other reading is skipped. The contact guard looks over the whole
-        window; `continues`: these steps follow such a call's (World.advance)."""
+    def _advance(self, count, touched, times=None, continues=False):
+        """`count` physics steps of a window that ends with an observation, `times` the sim
+        times at the end of each of its steps (default: world.times_after(count)): the
+        laser's last scan in the window is collected if it falls in these steps, every other
+        reading is skipped. The contact guard looks over the whole window; `continues`:
+        these steps follow such a call's (World.advance)."""
         world = self.world
-        window = window or count
-        scans = self._laser.scans_at(world.times_after(window))
+        if times is None:
+            times = world.times_after(count)
+        scans = self._laser.scans_at(times)
         last = scans[-1] if scans and scans[-1] < count else None
         return world.advance(count, collect=() if last is None else (self._laser,),
                              touched=touched, collect_from=last or 0, continues=continues,
-                             horizon=window)
+                             horizon=len(times))
 
     def _snapshot(self, readings, touched):
         for reading in readings:
