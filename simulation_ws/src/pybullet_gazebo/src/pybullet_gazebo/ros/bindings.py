@@ -43,7 +43,6 @@ from pybullet_gazebo.ros.watch_rate import WallRateLimit, topic_limit
 class BindingContext:
     """What the simulator node lends every binding."""
     tf_publisher: Callable[[], DirectPublisher]   # the node's /tf publisher, made on first use
-    command_arrived: Callable[[], None]           # tells lockstep a command came in
     debug: bool = False
     watch_rate: float = 0.0                       # [Hz wall] ~watch_rate (watch_rate.py)
 
@@ -73,10 +72,6 @@ class Binding:
     def publish(self, data, stamp) -> bool:
         """Publishes one reading; True when it was a scan (lockstep counts scans)."""
         return False
-
-    def commands_heard(self) -> bool:
-        """Whether a controller publishes on one of this part's command topics."""
-        return any(s.get_num_connections() for s in self.subscribers)
 
     def loop_nodes(self) -> set:
         """The nodes that command this part or read its sensor or odometry topics: they may
@@ -134,7 +129,6 @@ class DriveBinding(Binding):
             # it here delayed commands by whole steps when running free. Setting the command
             # is one attribute write, read by the drive at its next update.
             drive.set_command(msg.linear.x, msg.angular.z)
-        self.context.command_arrived()
 
     def publish(self, data, stamp):
         odometry_heard = self.odometry.get_num_connections() > 0
@@ -195,9 +189,6 @@ class RobotBindings:
     def publish(self, reading, stamp) -> bool:
         binding = self.by_part.get(id(reading.part))
         return binding.publish(reading.data, stamp) if binding is not None else False
-
-    def commands_heard(self) -> bool:
-        return any(b.commands_heard() for b in self.by_part.values())
 
     def loop_nodes(self) -> set:
         return set().union(*(b.loop_nodes() for b in self.by_part.values()))

@@ -55,20 +55,24 @@ class ClockTopic:
         self._watchers = {}                 # node name -> _Watcher
         self._latest = None                 # the last tick sent (a Clock message)
 
-    def publish(self, stamp):
-        """One tick at sim time `stamp` (rospy Time) to whoever is due for it."""
+    def publish(self, stamp, loop_nodes=True):
+        """One tick at sim time `stamp` (rospy Time) to whoever is due for it; with
+        `loop_nodes` false, not to the loop nodes (lockstep sends them theirs with
+        publish_to_loop_nodes once they are done with the readings of that time)."""
         msg = Clock(stamp)
         self._latest = msg
-        if not self._limited:
+        if not self._limited and loop_nodes:
             self.publisher.publish(msg)
             return
         now = stamp.to_sec()
-        loop_nodes = self._loop_nodes()
+        nodes = self._loop_nodes()
         self._forget_gone()
 
         def share(connection):
             node = connection.endpoint_id
-            if node in loop_nodes:
+            if node in nodes:
+                return loop_nodes
+            if not self._limited:
                 return True
             watcher = self._watcher(node)
             since = math.inf if watcher.last is None else now - watcher.last
@@ -79,6 +83,12 @@ class ClockTopic:
             return False
 
         self.publisher.publish(msg, share)
+
+    def publish_to_loop_nodes(self, stamp):
+        """The tick at `stamp` to the loop nodes only (lockstep)."""
+        nodes = self._loop_nodes()
+        if nodes:
+            self.publisher.publish(Clock(stamp), lambda c: c.endpoint_id in nodes)
 
     def flush(self):
         """The latest tick to each watcher that has not had it (call while paused)."""

@@ -4,31 +4,28 @@ RealTimePacer holds sim time to `real_time_factor` sim seconds per wall second (
 as the machine allows); when the machine falls more than half a second behind it does not try
 to catch up.
 
-Lockstep (see README, "Lockstep"): after a step that published a scan, the loop may step on
-until the drive next reads its command (`next_command_time`), and there waits until a
-controller has answered (a command counted since that scan), at most `timeout` wall seconds.
-The answer then reaches the wheels at the same sim time on every run.
+Lockstep's contract (README, "Lockstep"): a controller in lockstep sees what a controller
+that takes no time would see at real time. Whatever it does with a message the simulator
+sends it (a scan, odometry, a /clock tick that wakes its rospy.Rate or rospy.Timer loop), it
+has done before the simulation goes on past the next moment that it could change: the next
+message to the controllers, or the next update at which a drive reads its command. So a tick
+at sim time t acts on the odometry, scans and TF published up to t, and its command reaches
+the wheels at the drive's first update after t, on every run, whatever the machine's load.
 
-Controllers that publish from their own loop (rospy.Rate, as the series' later programs do)
-wake on /clock, not on scans: when no answer came within WAKE_AFTER of wall time,
-`before_wait` is called (the node brings /clock up to now), so a loop whose tick fell since
-the last /clock publishes its command before the drive reads it. A loop whose next tick lies
-after the drive's update cannot answer before it (in Gazebo its command too reaches the
-wheels one update later): seen in the series' bug programs when a behaviour is switched on
-just after its loop ticked. So when no answer came within `step_on_after` (0.25 s, or a
-quarter of `timeout` when that is longer) of the scan's wait, lockstep steps on without a
-word (before: it stalled the whole `timeout`, 1 s, and logged
-`no cmd_vel within`). When no command at all comes for `timeout` (every controller switched
-off, say), lockstep reports it once and stops waiting until the next command arrives,
-instead of stalling at every scan. A controller that answers scans is waited for up to
-`step_on_after`: far more than it takes (a few ms); where even a rare step-on must not happen
-(the batch runner's metrics must not depend on the machine's load), raise `timeout`
-(lockstep_timeout): the batch runner's 30 s makes it 7.5 s. Time spent paused
-is not silence: a pause (an agent that thinks between steps, a user at the GUI) interrupts
-the wait, and the wait starts afresh, for the same answer, once physics runs again. A reset forgets both the awaited answer and the
-silence (a new episode: its controller is waited for again).
+How: the loop tells Lockstep when it sends something to the loop nodes (`sending`, see
+clock_topic.py for who they are), and before it sends the next thing or steps into a command
+update it calls `settle`, which waits until the loop nodes' processes and the simulator's own
+readers are idle (idle_threads.py, own_receivers.py): done with what they got, their answers
+(commands, service calls) in. A controller that is idle and published nothing has nothing to
+say this tick: lockstep does not wait for a command that will not come.
+
+What it cannot promise: a node on another machine cannot be watched (it is named in the run
+summary); a thread that computes for longer than idle_threads.SPIN_CPU of CPU at once is
+taken for a busy loop and not waited for; a program that acts on wall time (time.sleep, a
+thread of its own timed by the wall clock) sees sim time run at whatever speed the machine
+gives. `timeout` [s wall] bounds each wait: a process still busy then is stepped past, and
+named once in the log and in the run summary.
 """
-import threading
 import time
 
 
@@ -57,115 +54,72 @@ class LockstepStats:
     """What lockstep cost in a run, for the simulator's run summary."""
 
     def __init__(self):
-        self.waits = 0              # scans whose answer was not in when the drive needed it
-        self.wake_ups = 0           # of those, waits that needed the wake-up /clock
-        self.step_ons = 0           # waits that ended without an answer, stepping on
-        self.timeouts = 0           # of those, the ones that found the controllers silent
+        self.settles = 0            # times the loop asked for the loop nodes to be idle
+        self.waits = 0              # of those, the ones that found someone at work
+        self.timeouts = 0           # waits that ended with someone still at work
         self.wall_waiting = 0.0     # [s] wall spent in those waits
+        self.stepped_past = {}      # who was still at work at a timeout -> times
 
     def summary(self):
-        return ("%d waits for a cmd_vel (%d needed the wake-up /clock, %d stepped on without "
-                "an answer, %d found the controllers silent), %.1f s of wall time waiting"
-                % (self.waits, self.wake_ups, self.step_ons, self.timeouts, self.wall_waiting))
+        text = ("%d waits for the controllers (of %d settles), %.1f s of wall time waiting, "
+                "%d time-outs" % (self.waits, self.settles, self.wall_waiting, self.timeouts))
+        if self.stepped_past:
+            text += " (still at work: %s)" % ", ".join(
+                "%s %d x" % item for item in sorted(self.stepped_past.items()))
+        return text
 
 
 class Lockstep:
-    WAKE_AFTER = 0.005        # [s] wall: how long an answer may take before the wake-up /clock
-    STEP_ON_AFTER = 0.25      # [s] wall, at least: no answer this long after a scan: step on
-    STEP_ON_SHARE = 0.25      # ... or this share of `timeout` when that is longer
-
-    def __init__(self, enabled, timeout, on_timeout, is_shutdown, before_wait=lambda: None,
-                 is_paused=lambda: False):
+    def __init__(self, enabled, timeout, watch, is_shutdown, is_paused=lambda: False,
+                 describe=str, on_timeout=lambda who: None):
+        """`watch`: an IdleWatch (idle_threads.py) that settle() waits on; `describe(busy)`:
+        a name for what watch.busy() returned (a node name), `on_timeout(name)`: told once
+        per name that a wait timed out on."""
         self.enabled = enabled
         self.timeout = timeout               # [s] wall
-        self.on_timeout = on_timeout         # called once per silence (see the docstring)
+        self.watch = watch
         self.is_shutdown = is_shutdown
         self.is_paused = is_paused           # physics paused: a wait ends without a verdict
-        self.before_wait = before_wait       # called before waiting for an answer not yet in
-        self.commands = 0                    # commands received since the start
+        self.describe = describe
+        self.on_timeout = on_timeout
         self.stats = LockstepStats()
-        self.silent_at = None                # commands counted when a wait last timed out
-        self._arrived = threading.Condition()
-        self._awaited = None                 # (commands counted at a scan, sim time needed by)
-        self._quiet = None                   # (commands counted, wall time) unanswered since
+        self._sent = False                   # something went to the loop nodes since settle
+
+    def sending(self):
+        """Something goes to the loop nodes now (call it just before): settle() waits for
+        them to be done with it."""
+        if self.enabled:
+            self._sent = True
+            self.watch.note_sent()
 
     @property
-    def step_on_after(self):
-        """[s] wall: how long a scan's answer is waited for before stepping on."""
-        return min(self.timeout, max(self.STEP_ON_AFTER, self.STEP_ON_SHARE * self.timeout))
-
-    def command_arrived(self):
-        with self._arrived:
-            self.commands += 1
-            self._arrived.notify_all()
-
-    def expect_answer(self, commands_before, needed_at):
-        """A scan went out when `commands_before` commands had come; its answer is needed
-        before the step that starts at `needed_at` [s] (None: no part takes commands)."""
-        if self.enabled and needed_at is not None:
-            self._awaited = (commands_before, needed_at)
-
-    def answer_needed_at(self):
-        """Sim time [s] before whose step lockstep may wait for an answer, or None."""
-        awaited = self._awaited
-        return awaited[1] if awaited is not None else None
+    def unsettled(self):
+        return self._sent
 
     def forget(self):
-        """A reset: no answer awaited, and no controller taken as silent any more."""
-        self._awaited = None
-        self.silent_at = None
-        self._quiet = None
+        """A reset: nothing sent is waited for any more."""
+        self._sent = False
 
-    def wait_if_due(self, sim_time, anyone_commands):
-        """Before a step at `sim_time`: waits for the awaited answer if it is needed now and
-        some controller publishes commands at all. False when physics was paused meanwhile:
-        the step must not be taken now, and the answer is still awaited."""
-        awaited = self._awaited
-        if awaited is None or sim_time < awaited[1]:
+    def settle(self):
+        """Waits until the loop nodes are done with what they were sent. False when physics
+        was paused meanwhile (the wait is taken up again once it runs)."""
+        if not self._sent:
             return True
-        if self.commands != awaited[0] or self.commands == self.silent_at \
-                or not anyone_commands():
-            self._awaited = None
-            return True             # answered already, controllers silent, or none at all
-        started = time.monotonic()
-        if self._quiet is not None and self._quiet[0] != self.commands:
-            self._quiet = None                       # a command came since: not quiet
-        # a controller that answers scans is usually a few ms away: no wake-up /clock for it
-        # (each /clock wakes every node); one on its own loop gets it after WAKE_AFTER
-        outcome = self._wait_for(awaited[0], started + min(self.WAKE_AFTER, self.timeout))
-        self.stats.waits += 1
-        if outcome is None:
-            self.stats.wake_ups += 1
-            self.before_wait()
-            outcome = self._wait_for(awaited[0], started + self.step_on_after)
-        self.stats.wall_waiting += time.monotonic() - started
-        if outcome is False:                         # paused: wait again after the pause
-            self._quiet = None
-            return False
-        self._awaited = None
-        if outcome:
-            self._quiet = None
-            return True
-        if self._quiet is None:
-            self._quiet = (self.commands, started)
-        if time.monotonic() - self._quiet[1] < self.timeout:
-            self.stats.step_ons += 1                 # its tick lies beyond the update
-            return True
-        self._quiet = None
-        self.stats.timeouts += 1
-        self.silent_at = self.commands
-        self.on_timeout()
-        return True
-
-    def _wait_for(self, commands_before, deadline):
-        """Waits until a command beyond `commands_before` came (True), physics was paused
-        (False) or the wall clock reached `deadline` (None)."""
-        with self._arrived:
-            while self.commands == commands_before and not self.is_shutdown():
-                if self.is_paused():
+        self.stats.settles += 1
+        busy = self.watch.busy()
+        if busy is not None:
+            started = time.monotonic()
+            self.stats.waits += 1
+            busy = self.watch.wait(started + self.timeout,
+                                   lambda: self.is_paused() or self.is_shutdown())
+            self.stats.wall_waiting += time.monotonic() - started
+            if busy is not None:
+                if self.is_paused() or self.is_shutdown():
                     return False
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    return None
-                self._arrived.wait(min(left, 0.02))
+                self.stats.timeouts += 1
+                who = self.describe(busy)
+                if who not in self.stats.stepped_past:
+                    self.on_timeout(who)
+                self.stats.stepped_past[who] = self.stats.stepped_past.get(who, 0) + 1
+        self._sent = False
         return True

@@ -12,8 +12,10 @@ parameters (~name), with units:
                       model_states, link_states and joint_states go out at most max(this,
                       their own rate) times per wall second; 0 = no limit (watch_rate.py)
   seed                seed of the sensors' noise
-  lockstep            after each scan, wait for the controller's cmd_vel (see README)
-  lockstep_timeout    [s] of wall time to wait for it before stepping on
+  lockstep            before the simulation goes on, wait until the controllers are done
+                      with what they were sent (pacing.py, README "Lockstep")
+  lockstep_timeout    [s] of wall time: the longest such wait; a controller still at work
+                      then is stepped past and named in the run summary
   cmd_vel_timeout     [s] of sim time after which a robot stops without commands; 0 = never
   gui                 open a window showing the world (needs a display; else headless)
   gui_fps             [Hz wall] at most this many frames per second in that window

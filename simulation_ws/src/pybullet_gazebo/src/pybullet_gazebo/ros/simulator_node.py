@@ -42,6 +42,9 @@ from pybullet_gazebo.ros.bindings import BindingContext, RobotBindings
 from pybullet_gazebo.ros.clock_topic import ClockTopic
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
+from pybullet_gazebo.ros.idle_threads import IdleWatch
+from pybullet_gazebo.ros.node_processes import NodeProcesses
+from pybullet_gazebo.ros.own_receivers import OwnReceivers
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
 from pybullet_gazebo.ros.state_topics import StateTopics
 from pybullet_gazebo.ros.watch_rate import topic_limit
@@ -73,16 +76,22 @@ class SimulatorNode:
         self.real_time_factor = world_rtf if params.real_time_factor is None \
             else params.real_time_factor
         self.pacer = RealTimePacer(self.real_time_factor, self.world.sim_time)
+        self._node_processes = NodeProcesses(rospy.get_name())
         self.lockstep = Lockstep(
-            params.lockstep, params.lockstep_timeout, is_shutdown=rospy.is_shutdown,
-            on_timeout=lambda: rospy.loginfo(
-                "lockstep: no cmd_vel within %.2f s of a scan; stepping on without waiting "
-                "until a cmd_vel comes again" % params.lockstep_timeout),
-            before_wait=self._clock_now, is_paused=lambda: self.paused)
+            params.lockstep, params.lockstep_timeout,
+            IdleWatch(own_busy=OwnReceivers().busy) if params.lockstep else None,
+            is_shutdown=rospy.is_shutdown, is_paused=lambda: self.paused,
+            describe=self._describe_busy,
+            on_timeout=lambda who: rospy.logwarn(
+                "lockstep: %s was still at work %.2f s after it was sent a message; stepping "
+                "on (lockstep_timeout; counted in the run summary)" % (who,
+                                                                     params.lockstep_timeout)))
+        self._loop_clock = None                   # lockstep: /clock the loop nodes still owe
+        self._watched_names = None                # lockstep: the loop nodes watched now
         self._bindings = {}                       # robot name -> RobotBindings
         self._running = False                     # run() is stepping
         self._tf_publisher = None
-        self._binding_context = BindingContext(self._tf, self.lockstep.command_arrived,
+        self._binding_context = BindingContext(self._tf,
                                                debug=params.debug, watch_rate=params.watch_rate)
         self._last_touching = []
         # publication periods in whole physics steps, so they never drift
@@ -171,6 +180,7 @@ class SimulatorNode:
                 self.world.reset_world()
             self.pacer.restart(self.world.sim_time)
             self.lockstep.forget()
+            self._loop_clock = None
 
     # --- the loop -------------------------------------------------------------------------
     def run(self):
@@ -191,28 +201,64 @@ class SimulatorNode:
                       if self.params.lockstep else "")
 
     def _loop(self):
+        lockstep = self.lockstep.enabled
         while not rospy.is_shutdown():
             if self.paused:
                 if self.clock_pub is not None:
                     self.clock_pub.flush()        # displays learn the paused time
                 time.sleep(0.01)
                 continue
-            if not self.lockstep.wait_if_due(self.world.sim_time, self._commands_heard):
+            if lockstep and self._command_update_next() and not self._settle_loop_nodes():
                 continue                          # paused while waiting: no step now
             with self.lock:
                 if self.paused:                   # paused (or reset) while we waited
                     continue
                 readings = self.world.advance(self._steps_ahead(), until_news=True)
-                commands_before = self.lockstep.commands
                 now = self.world.sim_time
-                scans = self._publish(readings)
+            # lockstep: the loop nodes are done with what they had before they get more
+            if lockstep and (readings or self._clock_due(force=False, peek=True)) \
+                    and not self._settle_loop_nodes():
+                continue
+            with self.lock:
+                self._publish(readings)
                 if self.window is not None:
                     self.window.after_step(readings)      # a frame at most gui_fps per second
-                needed_at = self.world.next_command_time() if scans else None
-            # The drive reads its command only at its next update (Gazebo's plugin does the
-            # same), so physics runs on until then while the controller thinks.
-            self.lockstep.expect_answer(commands_before, needed_at)
             self.pacer.pace(now)
+
+    def _command_update_next(self):
+        """True when the next step starts with a drive reading its command."""
+        needed_at = self.world.next_command_time()
+        return needed_at is not None and self.world.sim_time >= needed_at
+
+    def _settle_loop_nodes(self):
+        """Lockstep: waits until the loop nodes are done with what they were sent, then
+        sends them the /clock tick they still owe (that of the readings they just took in:
+        after them, so that a rospy.Rate loop it wakes reads them) and waits for that too.
+        False when physics was paused meanwhile."""
+        if not (self.lockstep.unsettled or self._loop_clock is not None):
+            return True
+        names = self._loop_nodes()
+        if names != self._watched_names:
+            self._watched_names = names
+            self.lockstep.watch.watch(self._node_processes.pids(names))
+            rospy.loginfo("lockstep: waits for %s", ", ".join(
+                "%s (pid %s)" % (n, self._node_processes.pid_of(n)) for n in sorted(names))
+                or "no controller")
+        if not self.lockstep.settle():
+            return False
+        if self._loop_clock is not None:
+            stamp, self._loop_clock = self._loop_clock, None
+            self.lockstep.sending()
+            self.clock_pub.publish_to_loop_nodes(stamp)
+            return self.lockstep.settle()
+        return True
+
+    def _describe_busy(self, busy):
+        pid, _ = busy
+        if pid == "self":
+            return "the simulator's own reader of a message"
+        names = [n for n, p in self._node_processes._pids.items() if p == pid]
+        return "node %s (pid %d)" % (names[0], pid) if names else "pid %s" % pid
 
     def _steps_ahead(self):
         """How many physics steps the loop may take in one World.advance (which stops early
@@ -232,16 +278,13 @@ class SimulatorNode:
         if self.state_topics.wanted():
             ahead = min(ahead, self._model_states_every
                         - world.step_count % self._model_states_every)
-        needed_at = self.lockstep.answer_needed_at()
+        needed_at = world.next_command_time() if self.lockstep.enabled else None
         if needed_at is not None:
             steps = 1               # the steps after the first start before `needed_at`
             while steps < ahead and world.time_after(steps) < needed_at:
                 steps += 1
             ahead = min(ahead, steps)
         return max(1, ahead)
-
-    def _commands_heard(self):
-        return any(b.commands_heard() for b in list(self._bindings.values()))
 
     def _loop_nodes(self):
         """Nodes that command a robot or read its sensors or odometry: they get every /clock
@@ -259,8 +302,13 @@ class SimulatorNode:
         if not (readings or contacts_changed or model_states_due or clock_due):
             return 0
         stamp = conversions.stamp_of_world(self.world)
+        lockstep = self.lockstep.enabled
         if clock_due:
-            self.clock_pub.publish(stamp)
+            self.clock_pub.publish(stamp, loop_nodes=not lockstep)
+            if lockstep:
+                self._loop_clock = stamp
+        if readings:
+            self.lockstep.sending()
         scans = 0
         for reading in readings:
             bindings = self._bindings.get(reading.robot.name)
@@ -273,22 +321,17 @@ class SimulatorNode:
             self.state_topics.publish()
         return scans
 
-    def _clock_now(self):
-        """/clock at the present sim time unless it went out this step: wakes controllers
-        that loop on rospy.Rate, whose tick may have fallen since the last /clock."""
-        with self.lock:
-            if self.world.step_count != self._last_clock_step and self._clock_due(force=True):
-                self.clock_pub.publish(conversions.stamp_of_world(self.world))
-
-    def _clock_due(self, force):
+    def _clock_due(self, force, peek=False):
         """/clock every _clock_every steps and on each step with readings (`force`), counted
         from the last /clock sent: the two cadences share ticks instead of adding up (at
-        20 Hz, /clock would otherwise go out at 40 Hz, its ticks between the scans')."""
+        20 Hz, /clock would otherwise go out at 40 Hz, its ticks between the scans').
+        `peek`: only say whether it is due, without counting it as sent."""
         if self.clock_pub is None:
             return False
         since = self.world.step_count - self._last_clock_step
         if force or since >= self._clock_every or since < 0:     # < 0: after a reset
-            self._last_clock_step = self.world.step_count
+            if not peek:
+                self._last_clock_step = self.world.step_count
             return True
         return False
 

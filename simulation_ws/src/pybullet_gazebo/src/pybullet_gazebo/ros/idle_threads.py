@@ -1,0 +1,246 @@
+"""Whether processes have finished with what they were sent: lockstep's barrier (pacing.py).
+
+Lockstep must know when every controller has done with a message before the simulation goes
+on. A program that answers scans publishes a command, but a program on its own rospy.Rate
+loop may tick without publishing (a state change, a behaviour switched off), publish twice,
+or publish from another thread; waiting for "a command" cannot tell. So the simulator looks
+at the controllers' processes themselves, as the kernel sees them: a process is idle when
+none of its threads is running or waiting for a CPU (state R in /proc/PID/task/TID/stat) or
+in an uninterruptible wait (D). That holds on a loaded machine too: a thread that waits for a
+CPU is R.
+
+Why "all threads asleep" means "done with what it was sent":
+- on localhost, writing to a socket wakes its reader inside the write call, so a message
+  the simulator has sent makes its reader R before the send returns;
+- a Python thread that waits for the GIL sleeps, but only while another thread of its
+  process holds the GIL, and that one is R (a thread that releases the GIL wakes the next
+  before it sleeps itself);
+- a controller's command travels the same way back: once its process is idle, the command
+  is in the simulator's socket or being read there (OwnReceivers checks that side).
+
+Busy loops. A thread that never sleeps (the series' go_to_point spins in
+`while not rospy.is_shutdown(): if not active_: continue` while switched off) is never idle.
+A thread seen running at every look for SPIN_WALL of wall time, having had at least
+SPIN_SHARE of a CPU in that time (less is a thread waiting for a CPU on a loaded machine), is
+taken for a busy loop and not waited for, until it is seen asleep while every other thread
+of its process sleeps too (asleep beside a running thread, it may only be waiting for the
+GIL; with no thread of its process running, nobody holds the GIL). The look that starts a
+wait starts the count afresh: a thread running at two looks with an idle spell between them
+is no busy loop. A thread that computes for longer than SPIN_WALL at once is taken for one
+too: lockstep then steps on without waiting for its answer.
+Beside a busy loop, "asleep" is not "done": the busy loop holds the GIL, and a thread woken
+by a message sleeps until it gets it (Python hands it over after its 5 ms switch interval).
+So in a process with a busy loop, a sleeping thread counts as done only if it has not run
+since the last message went out (its count of runs in /proc/.../schedstat), or it sleeps in
+a socket wait (back to reading: done), or it has not run while the busy loop ran for
+GIL_WAIT of CPU (a thread waiting for the GIL wakes every 5 ms, the switch interval, to ask
+for it, or waits for the busy loop to release the GIL's mutex, which takes the busy loop's
+running: on a loaded machine, where the busy loop waits for a CPU, this takes longer). A busy loop thus costs lockstep about one switch interval of wall time per message
+its process gets, as it delays that process's callbacks at real time.
+
+Linux only (/proc); threads of processes on other machines cannot be watched.
+"""
+import os
+import time
+
+SPIN_WALL = 0.1          # [s] wall: running at every look for this long ...
+SPIN_SHARE = 0.25        # ... on at least this share of a CPU: a busy loop
+GIL_WAIT = 0.006         # [s] wall: longer than Python's 5 ms switch interval
+
+# system call numbers of the socket waits a reader sleeps in (x86_64, aarch64)
+SOCKET_WAITS = {
+    "x86_64": {0, 7, 23, 43, 45, 47, 232, 270, 271, 281, 288},   # read poll select accept
+    #         recvfrom recvmsg epoll_wait pselect6 ppoll epoll_pwait accept4
+    "aarch64": {63, 73, 72, 202, 207, 212, 22, 242},   # read ppoll pselect6 accept recvfrom
+    #         recvmsg epoll_pwait accept4
+}.get(os.uname().machine, set())
+
+_BUSY_STATES = (ord("R"), ord("D"))
+
+
+def _state_of(stat):
+    """The state letter (as a byte value) of a /proc/.../stat line; its command name may hold
+    spaces and parentheses, so the state is found after the last ')'."""
+    return stat[stat.rindex(b")") + 2]
+
+
+class _Thread:
+    """What the watch remembers of one thread."""
+    __slots__ = ("fd", "busy_since", "cpu_since", "spinning", "runs_at_send", "runs_seen",
+                 "runs_seen_at")
+
+    def __init__(self, fd):
+        self.fd = fd
+        self.busy_since = None      # [s] monotonic: first seen running in this streak
+        self.cpu_since = 0          # [ns] its CPU time then
+        self.spinning = False
+        self.runs_at_send = None    # its count of runs when the last message went out
+        self.runs_seen = None       # its count of runs at the last look (beside a busy loop)
+        self.runs_seen_at = None    # [ns] the busy loops' CPU time when that count was seen
+
+
+class ProcessThreads:
+    """The threads of one process, their /proc stat files kept open (re-read with pread)."""
+
+    def __init__(self, pid):
+        self.pid = pid
+        self.task_dir = "/proc/%d/task" % pid
+        self.threads = {}           # tid -> _Thread
+
+    def busy_thread(self, now, round_start):
+        """A tid that is running and not a busy loop (None: the process is idle), or False
+        when the process is gone. `round_start`: when the present wait began."""
+        try:
+            tids = [int(name) for name in os.listdir(self.task_dir)]
+        except OSError:
+            return False
+        running = {}
+        for tid in tids:
+            thread = self.threads.get(tid)
+            try:
+                if thread is None:
+                    thread = self.threads[tid] = _Thread(
+                        os.open("%s/%d/stat" % (self.task_dir, tid), os.O_RDONLY))
+                running[tid] = _state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES
+            except (OSError, ValueError, IndexError):
+                continue                                   # the thread ended meanwhile
+        threads = self.threads
+        others_run = any(run for tid, run in running.items() if not threads[tid].spinning)
+        spinners = [tid for tid, t in threads.items() if t.spinning]
+        spun = sum(self._cpu_ns(tid) for tid in spinners) if spinners else None
+        busy = None
+        for tid, run in running.items():
+            thread = threads[tid]
+            if thread.spinning:
+                if not run and not others_run:
+                    thread.spinning = False                # asleep, and not for the GIL
+                continue
+            if not run:
+                thread.busy_since = None
+                if spinners and not self._done_beside_spinner(tid, thread, spun):
+                    busy = tid if busy is None else busy
+                continue
+            if thread.busy_since is None or thread.busy_since < round_start:
+                thread.busy_since, thread.cpu_since = now, self._cpu_ns(tid)
+            elif now - thread.busy_since >= SPIN_WALL and self._cpu_ns(tid) - \
+                    thread.cpu_since >= SPIN_SHARE * 1e9 * (now - thread.busy_since):
+                thread.spinning = True
+                continue
+            if busy is None:
+                busy = tid
+        if len(threads) > len(tids):
+            self._forget_ended(set(tids))
+        return busy
+
+    def spinners(self):
+        return [tid for tid, t in self.threads.items() if t.spinning]
+
+    def note_sent(self):
+        """A message went out to this process: beside a busy loop, remember how often each
+        thread has run so far."""
+        if any(t.spinning for t in self.threads.values()):
+            for tid, thread in self.threads.items():
+                if not thread.spinning:
+                    thread.runs_at_send = self._schedstat(tid, 2)
+
+    def _done_beside_spinner(self, tid, thread, spun):
+        """A sleeping thread in a process with a busy loop: done with what it was sent?
+        `spun` [ns]: the busy loops' CPU time now."""
+        runs = self._schedstat(tid, 2)
+        if runs == thread.runs_at_send:
+            return True                            # it has not run since the message
+        try:
+            with open("%s/%d/syscall" % (self.task_dir, tid), "rb") as f:
+                call = f.read().split(None, 1)[0]
+            if call.isdigit() and int(call) in SOCKET_WAITS:
+                return True                        # back to reading its socket
+        except (OSError, IndexError):
+            return True                            # ended
+        if runs != thread.runs_seen:
+            thread.runs_seen, thread.runs_seen_at = runs, spun
+            return False
+        return spun - thread.runs_seen_at >= GIL_WAIT * 1e9   # no GIL waiter sleeps so long
+
+    def _cpu_ns(self, tid):
+        return self._schedstat(tid, 0)
+
+    def _schedstat(self, tid, field):
+        """A field of /proc/PID/task/TID/schedstat: 0 = CPU time [ns], 2 = runs."""
+        try:
+            with open("%s/%d/schedstat" % (self.task_dir, tid), "rb") as f:
+                return int(f.read().split()[field])
+        except (OSError, ValueError, IndexError):
+            return 0
+
+    def _forget_ended(self, present):
+        for tid in [t for t in self.threads if t not in present]:
+            os.close(self.threads.pop(tid).fd)
+
+    def close(self):
+        for thread in self.threads.values():
+            os.close(thread.fd)
+        self.threads.clear()
+
+
+class IdleWatch:
+    """Waits until a set of processes is idle (see the module docstring)."""
+
+    POLL = 0.0001            # [s] wall between looks
+
+    def __init__(self, own_busy=lambda: False):
+        self.own_busy = own_busy            # the simulator's own side (OwnReceivers.busy)
+        self._processes = {}                # pid -> ProcessThreads
+        self._round_start = 0.0             # [s] monotonic: when the present wait began
+
+    def watch(self, pids):
+        """From now on, the processes `pids` (an iterable of ints)."""
+        pids = set(pids)
+        for pid in [p for p in self._processes if p not in pids]:
+            self._processes.pop(pid).close()
+        for pid in pids:
+            if pid not in self._processes:
+                self._processes[pid] = ProcessThreads(pid)
+
+    def note_sent(self):
+        """A message went out to the watched processes (see ProcessThreads.note_sent)."""
+        for process in self._processes.values():
+            process.note_sent()
+
+    @property
+    def pids(self):
+        return set(self._processes)
+
+    def busy(self, new_round=True):
+        """(pid, tid) of a thread still at work, ("self", None) for the simulator's own
+        receivers, or None when all are idle. Processes that ended are dropped.
+        `new_round`: this look starts a wait (see the module docstring on busy loops)."""
+        now = time.monotonic()
+        if new_round:
+            self._round_start = now
+        for pid, process in list(self._processes.items()):
+            tid = process.busy_thread(now, self._round_start)
+            if tid is False:
+                self._processes.pop(pid).close()
+            elif tid is not None:
+                return pid, tid
+        if self.own_busy():
+            return "self", None
+        return None
+
+    def wait(self, deadline, interrupted=lambda: False):
+        """Waits until every watched process is idle (None) or the monotonic clock reaches
+        `deadline` or interrupted() is true (the (pid, tid) still busy)."""
+        while True:
+            busy = self.busy(new_round=False)
+            if busy is None:
+                return None
+            if time.monotonic() >= deadline or interrupted():
+                return busy
+            time.sleep(self.POLL)
+
+    def spinners(self):
+        """{pid: [tid, ...]} of the threads taken for busy loops now."""
+        return {pid: p.spinners() for pid, p in self._processes.items() if p.spinners()}
+
+    def close(self):
+        self.watch(())

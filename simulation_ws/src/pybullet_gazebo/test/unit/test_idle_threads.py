@@ -1,0 +1,146 @@
+"""Lockstep's barrier on real processes (no ROS): a child that works on what it is sent is
+waited for until it is done; a busy loop is found and not waited for; beside one, a thread
+waiting for the GIL is still waited for."""
+import select
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+from pybullet_gazebo.ros.idle_threads import IdleWatch
+
+# Reads a line from stdin, burns `work` s of CPU, answers "done <line>" on stdout.
+WORKER = """
+import sys, time
+work = float(sys.argv[1])
+print("ready", flush=True)
+for line in sys.stdin:
+    end = time.thread_time() + work
+    while time.thread_time() < end:
+        pass
+    print("done " + line.strip(), flush=True)
+"""
+
+# The same beside a thread that spins for ever without sleeping (as the series' go_to_point
+# does while switched off): the reader needs the GIL the spinner holds.
+WORKER_BESIDE_SPINNER = """
+import sys, threading
+def spin():
+    while True:
+        pass
+threading.Thread(target=spin, daemon=True).start()
+print("ready", flush=True)
+for line in sys.stdin:
+    print("done " + line.strip(), flush=True)
+"""
+
+# Spins for `spin` s, then sleeps reading stdin.
+SPIN_THEN_SLEEP = """
+import sys, time
+print("ready", flush=True)
+end = time.monotonic() + float(sys.argv[1])
+while time.monotonic() < end:
+    pass
+print("asleep", flush=True)
+sys.stdin.readline()
+"""
+
+
+@pytest.fixture
+def child():
+    children = []
+
+    def start(code, *args):
+        process = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)] + list(args),
+                                   stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        children.append(process)
+        assert process.stdout.readline().strip() == "ready"     # Python has started
+        return process
+
+    yield start
+    for process in children:
+        process.kill()
+        process.wait()
+        process.stdin.close()
+        process.stdout.close()
+
+
+def answered(process):
+    """The lines the child has written so far, without waiting."""
+    lines = []
+    while select.select([process.stdout], [], [], 0)[0]:
+        line = process.stdout.readline()
+        if not line:
+            break
+        lines.append(line.strip())
+    return lines
+
+
+def settle(watch, timeout=5.0):
+    """What lockstep's settle does: a first look, then the wait."""
+    if watch.busy() is None:
+        return None
+    return watch.wait(time.monotonic() + timeout)
+
+
+def test_a_sleeping_process_is_idle(child):
+    worker = child(WORKER, "0.01")
+    watch = IdleWatch()
+    watch.watch([worker.pid])
+    assert watch.busy() is None
+
+
+def test_waits_until_the_child_is_done_with_each_message(child):
+    worker = child(WORKER, "0.02")                 # 20 ms of CPU per message
+    watch = IdleWatch()
+    watch.watch([worker.pid])
+    for n in range(20):
+        watch.note_sent()
+        worker.stdin.write("%d\n" % n)
+        worker.stdin.flush()
+        assert settle(watch) is None
+        assert answered(worker) == ["done %d" % n]  # its answer is out when the wait ends
+
+
+def test_a_busy_loop_is_found_and_not_waited_for(child):
+    spinner = child(SPIN_THEN_SLEEP, "30")
+    watch = IdleWatch()
+    watch.watch([spinner.pid])
+    start = time.monotonic()
+    assert settle(watch, timeout=5.0) is None
+    assert time.monotonic() - start < 1.0
+    assert list(watch.spinners()) == [spinner.pid]
+
+
+def test_a_busy_loop_that_went_to_sleep_is_waited_for_again(child):
+    spinner = child(SPIN_THEN_SLEEP, "0.3")
+    watch = IdleWatch()
+    watch.watch([spinner.pid])
+    assert settle(watch) is None and list(watch.spinners()) == [spinner.pid]
+    assert spinner.stdout.readline().strip() == "asleep"
+    time.sleep(0.05)
+    assert watch.busy() is None and watch.spinners() == {}
+
+
+def test_beside_a_busy_loop_a_thread_waiting_for_the_gil_is_waited_for(child):
+    worker = child(WORKER_BESIDE_SPINNER)
+    watch = IdleWatch()
+    watch.watch([worker.pid])
+    assert settle(watch) is None and list(watch.spinners()) == [worker.pid]
+    for n in range(10):
+        watch.note_sent()
+        worker.stdin.write("%d\n" % n)
+        worker.stdin.flush()
+        assert settle(watch) is None
+        assert answered(worker) == ["done %d" % n]
+
+
+def test_a_process_that_ended_is_dropped(child):
+    worker = child(WORKER, "0.01")
+    watch = IdleWatch()
+    watch.watch([worker.pid])
+    worker.kill()
+    worker.wait()
+    assert watch.busy() is None and watch.pids == set()
