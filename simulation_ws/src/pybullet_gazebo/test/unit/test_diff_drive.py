@@ -65,7 +65,7 @@ class Sim:
         for index in self.joints.values():            # free joints, Gazebo-like friction
             c.setJointMotorControl2(self.body, index, pybullet.VELOCITY_CONTROL, force=0)
             c.changeDynamics(self.body, index, lateralFriction=1.0)
-        c.changeDynamics(self.body, -1, lateralFriction=0.0)    # the caster: mu = 0
+        c.changeDynamics(self.body, -1, lateralFriction=1.0)    # box and caster: mu 1, as Gazebo
         self.warnings = []
         self.drive = DiffDrive(c, self.body, self.joints,
                                PluginSpec("differential_drive_controller", DiffDrive.KEY,

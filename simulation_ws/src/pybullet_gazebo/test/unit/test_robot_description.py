@@ -1,6 +1,7 @@
 """robot_description: the tutorial's m2wr (expanded by xacro from m2wr_description) parsed value
-by value against the reference, the friction rule, strip_for_bullet's output in pybullet, and
-the errors and warnings for bad descriptions."""
+by value against the reference, friction and contact as Gazebo takes them from a URDF (only
+from <gazebo reference>; a <surface> inside a <collision> is ignored, with a warning),
+strip_for_bullet's output in pybullet, and the errors and warnings for bad descriptions."""
 import os
 import xml.etree.ElementTree as ET
 
@@ -35,10 +36,18 @@ def urdf(body, root='<link name="base"/>'):
 
 
 # --- the tutorial's robot ------------------------------------------------------------------
-def test_m2wr_root_link_name_and_no_warnings(m2wr):
+CASTER_WARNING = (
+    "link 'link_chassis' collision 'caster_front_collision': <surface> is ignored, as in "
+    "Gazebo: a URDF <collision> is read for its name, <origin> and <geometry> only, so this "
+    "collision has the link's friction, mu = mu2 = 1 (SDF's default). To set friction or "
+    "contact values, use <gazebo reference=\"link_chassis\"> with <mu1>/<mu2> (<kp>/<kd>) "
+    "instead")
+
+
+def test_m2wr_root_link_name_and_one_warning_for_the_casters_surface(m2wr):
     assert m2wr.name == "m2wr"
     assert m2wr.root_link == "link_chassis"
-    assert m2wr.warnings == ()
+    assert m2wr.warnings == (CASTER_WARNING,)
 
 
 def test_m2wr_ray_sensor_has_the_reference_values(m2wr):
@@ -113,10 +122,14 @@ def test_m2wr_links_have_the_reference_values(m2wr_urdf):
     assert robot.find("joint[@name='joint_sensor_laser']").get("type") == "fixed"
 
 
-def test_m2wr_caster_friction_is_zero_and_goes_to_the_chassis(m2wr):
-    assert m2wr.collision_friction == {("link_chassis", "caster_front_collision"): (0.0, 0.0)}
+def test_m2wr_casters_surface_is_ignored_as_gazebo_ignores_it(m2wr_urdf, m2wr):
+    """The xacro writes mu = mu2 = 0 inside the caster's URDF <collision>, where Gazebo never
+    reads it: no link gets a friction from the description (all keep SDF's mu = mu2 = 1)."""
+    caster = ET.fromstring(m2wr_urdf).find("link/collision[@name='caster_front_collision']")
+    assert caster.find("surface/friction/ode/mu").text == "0"       # the tutorial's text
     assert m2wr.link_friction == {}
-    assert effective_link_friction(m2wr) == {"link_chassis": (0.0, 0.0)}
+    assert effective_link_friction(m2wr) == {}
+    assert effective_link_contact(m2wr) == {}
 
 
 def test_stripped_m2wr_loads_in_pybullet_with_its_joints_and_inertias(m2wr_urdf, tmp_path):
@@ -221,42 +234,41 @@ def test_other_sensor_types_warn_with_type_and_link():
     assert "'camera'" in spec.warnings[0] and "link 'base'" in spec.warnings[0]
 
 
-def test_gazebo_mu_sets_link_friction_and_wins_over_collision_surfaces():
-    link = ('<link name="base"><collision name="skid"><geometry><sphere radius="0.1"/>'
+SURFACES = ('<link name="base"><collision name="skid"><geometry><sphere radius="0.1"/>'
             '</geometry><surface><friction><ode><mu>0.2</mu></ode></friction></surface>'
             '</collision><collision><geometry><box size="1 1 1"/></geometry><surface>'
-            '<friction><ode><mu>0.1</mu><mu2>0.3</mu2></ode></friction></surface></collision>'
-            '</link><link name="wheel"/>')
-    joint = '<joint name="j" type="fixed"><parent link="base"/><child link="wheel"/></joint>'
-    block = '<gazebo reference="wheel"><mu1>0.7</mu1></gazebo>'
-    spec = parse_robot(urdf(joint + block, root=link), "m")
-    # a missing mu2 is SDF's default 1; an unnamed collision is keyed by its index
-    assert spec.collision_friction == {("base", "skid"): (0.2, 1.0), ("base", "1"): (0.1, 0.3)}
-    assert spec.link_friction == {"wheel": (0.7, 1.0)}
-    assert effective_link_friction(spec) == {"base": (0.1, 0.3), "wheel": (0.7, 1.0)}
-
-    block = '<gazebo reference="base"><mu1>0.9</mu1><mu2>0.8</mu2></gazebo>'
-    overridden = parse_robot(urdf(joint + block, root=link), "m")
-    assert effective_link_friction(overridden)["base"] == (0.9, 0.8)
+            '<friction><ode><mu>0.1</mu><mu2>0.3</mu2></ode></friction><contact><ode><kp>5e4'
+            '</kp><kd>20</kd></ode></contact></surface><surface/><material name="red"/>'
+            '</collision></link><link name="wheel"/>')
+WHEEL_JOINT = '<joint name="j" type="fixed"><parent link="base"/><child link="wheel"/></joint>'
 
 
-def test_gazebo_kp_kd_set_the_link_contact_spring_and_win_over_collision_surfaces():
-    link = ('<link name="base"><collision name="pad"><geometry><sphere radius="0.1"/>'
-            '</geometry><surface><contact><ode><kp>5e4</kp><kd>20</kd></ode></contact>'
-            '</surface></collision><collision><geometry><box size="1 1 1"/></geometry>'
-            '<surface><contact><ode><kp>1e6</kp></ode></contact></surface></collision></link>'
-            '<link name="wheel"/><link name="other"/>')
-    joints = ('<joint name="j" type="fixed"><parent link="base"/><child link="wheel"/></joint>'
-              '<joint name="k" type="fixed"><parent link="base"/><child link="other"/></joint>')
-    block = '<gazebo reference="wheel"><kp>1e5</kp></gazebo>'
-    spec = parse_robot(urdf(joints + block, root=link), "m")
-    assert spec.warnings == ()
-    assert spec.collision_contact == {("base", "pad"): (5e4, 20.0), ("base", "1"): (1e6, None)}
-    # the softest collision of a link; a value given nowhere is SDF's default (kd 1)
-    assert effective_link_contact(spec) == {"base": (5e4, 20.0), "wheel": (1e5, 1.0)}
-    block = '<gazebo reference="base"><kd>3</kd></gazebo>'
-    spec = parse_robot(urdf(joints + block, root=link), "m")
-    assert effective_link_contact(spec)["base"] == (5e4, 3.0)
+def test_collision_surfaces_are_ignored_with_one_warning_per_collision_and_element():
+    spec = parse_robot(urdf(WHEEL_JOINT, root=SURFACES), "m")
+    assert effective_link_friction(spec) == {}
+    assert effective_link_contact(spec) == {}
+    # a named collision by its name, an unnamed one by its index; <surface> twice: one warning
+    assert [w.split(": <")[0] for w in spec.warnings] == [
+        "link 'base' collision 'skid'", "link 'base' collision 1 (unnamed, counted from 0)",
+        "link 'base' collision 1 (unnamed, counted from 0)"]
+    assert [w.split(": <")[1].split(">")[0] for w in spec.warnings] == [
+        "surface", "surface", "material"]
+    for warning in spec.warnings:
+        assert "mu = mu2 = 1 (SDF's default)" in warning
+        assert 'use <gazebo reference="base"> with <mu1>/<mu2> (<kp>/<kd>) instead' in warning
+
+
+def test_gazebo_mu_and_kp_kd_set_the_link_and_collision_surfaces_do_not():
+    block = ('<gazebo reference="base"><mu1>0.9</mu1><mu2>0.8</mu2><kd>3</kd></gazebo>'
+             '<gazebo reference="wheel"><mu1>0.7</mu1><kp>1e5</kp></gazebo>')
+    spec = parse_robot(urdf(WHEEL_JOINT + block, root=SURFACES), "m")
+    # a value missing from a pair is SDF's default: mu2 1, kp 1e12 N/m, kd 1 N s/m
+    assert spec.link_friction == {"base": (0.9, 0.8), "wheel": (0.7, 1.0)}
+    assert effective_link_friction(spec) == {"base": (0.9, 0.8), "wheel": (0.7, 1.0)}
+    assert effective_link_contact(spec) == {"base": (1e12, 3.0), "wheel": (1e5, 1.0)}
+    assert len(spec.warnings) == 3
+    assert "this collision has the link's friction, mu1 = 0.9, mu2 = 0.8 (its <gazebo " \
+           "reference>)" in spec.warnings[0]
 
 
 def test_m2wr_has_gazebo_default_contact_springs(m2wr):

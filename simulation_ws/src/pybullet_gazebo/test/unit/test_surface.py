@@ -1,5 +1,6 @@
 """Contact surfaces as Gazebo has them (surface.py): the friction of a pair is Gazebo's
-min(mu_a, mu_b), not Bullet's product; kp and kd reach Bullet. DIRECT mode, no ROS."""
+min(mu_a, mu_b), not Bullet's product; kp and kd reach Bullet; a URDF gives them only through
+<gazebo reference> (robot_description). DIRECT mode, no ROS."""
 import os
 
 import pybullet
@@ -14,6 +15,7 @@ from pybullet_gazebo.engine.wheel_contact import SUFFIX
 from pybullet_gazebo.engine.world import World
 
 SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+FIXTURES = os.path.join(SRC, "pybullet_gazebo", "test", "fixtures")
 G = 9.8                  # [m/s^2] the worlds' gravity
 STEP = 0.001             # [s]
 
@@ -103,13 +105,16 @@ def test_a_box_sliding_on_the_ground_decelerates_at_the_smaller_mu_times_g(
 
 
 def test_m2wr_meets_world02_with_gazebos_friction(clients):
-    """The wheels' ground contacts get min(1, 100) = 1 (it was 10: 1 x 100, clamped), the
-    caster 0, a wheel against a barrier min(1, 1) = 1."""
+    """The wheels' ground contacts get min(1, 100) = 1 (it was 10: 1 x 100, clamped), a wheel
+    against a barrier min(1, 1) = 1, and the caster min(1, 100) = 1, as in Gazebo: the xacro's
+    mu 0 sits in a <surface> inside the URDF <collision>, which Gazebo never reads (the
+    stand-in gave it 0 before). One warning at spawn says so."""
     client = BulletClient(connection_mode=pybullet.DIRECT)
     clients.append(client)
     spec = load_world(os.path.join(SRC, "my_worlds", "worlds", "world02.world"),
                       model_path_from_env(os.path.join(SRC, "pybullet_gazebo", "models")))
-    world = World(client, spec, 0.005, warn=lambda _m: None)
+    warnings = []
+    world = World(client, spec, 0.005, warn=warnings.append)
     urdf = xacro.process_file(os.path.join(SRC, "m2wr_description", "urdf",
                                            "m2wr.xacro")).toxml()
     robot = world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(0, 8, 0.5))
@@ -126,7 +131,42 @@ def test_m2wr_meets_world02_with_gazebos_friction(clients):
         assert surface.bullet_pair_friction(contact, ground) == pytest.approx(1.0)
         assert surface.bullet_pair_friction(coefficient(robot.body_id, links[wheel]),
                                             barrier) == pytest.approx(1.0)
-    assert surface.bullet_pair_friction(coefficient(robot.body_id, -1), ground) == 0.0
+    # link_chassis (Bullet's base, -1) holds the chassis box and the caster sphere
+    assert surface.bullet_pair_friction(coefficient(robot.body_id, -1), ground) == \
+        surface.gazebo_friction(surface.DEFAULT_MU, 100.0) == 1.0
+    about_caster = [w for w in warnings if "caster_front_collision" in w]
+    assert about_caster == [
+        "model 'm2wr': link 'link_chassis' collision 'caster_front_collision': <surface> is "
+        "ignored, as in Gazebo: a URDF <collision> is read for its name, <origin> and "
+        "<geometry> only, so this collision has the link's friction, mu = mu2 = 1 (SDF's "
+        "default). To set friction or contact values, use <gazebo reference=\"link_chassis\"> "
+        "with <mu1>/<mu2> (<kp>/<kd>) instead"]
+
+
+def test_gazebo_reference_friction_and_contact_reach_bullet(clients, tmp_path):
+    """fixtures/urdf/gazebo_reference_friction.urdf: <gazebo reference="base"> mu1 0.3 (its
+    collision's <surface> mu 0 is ignored), <gazebo reference="pad"> mu1 0, kp 1e5, kd 20;
+    on a ground of mu 100 the pairs get Gazebo's min: 0.3 and 0."""
+    client = BulletClient(connection_mode=pybullet.DIRECT)
+    clients.append(client)
+    warnings = []
+    world = World(client, load_world(world_file(tmp_path, 100, 1), []), STEP,
+                  warn=warnings.append)
+    with open(os.path.join(FIXTURES, "urdf", "gazebo_reference_friction.urdf")) as source:
+        robot = world.spawn_urdf("fx", source.read(), Pose.from_xyz_rpy(2, 0, 0.2))
+    ground = client.getDynamicsInfo(world.entity("ground").body_ids[0], -1)[1]
+    base = client.getDynamicsInfo(robot.body_id, robot.links["base"])
+    pad = client.getDynamicsInfo(robot.body_id, robot.links["pad"])
+    assert base[1] == pytest.approx(0.3)
+    assert surface.bullet_pair_friction(base[1], ground) == pytest.approx(
+        surface.gazebo_friction(0.3, 100.0))
+    assert pad[1] == 0.0
+    assert surface.bullet_pair_friction(pad[1], ground) == 0.0
+    assert (pad[9], pad[8]) == pytest.approx((1e5, 20.0))       # contact stiffness, damping
+    assert len(warnings) == 1
+    assert warnings[0].startswith("model 'fx': link 'base' collision 'skid': <surface> is "
+                                  "ignored, as in Gazebo")
+    assert "mu1 = 0.3, mu2 = 0.4 (its <gazebo reference>)" in warnings[0]
 
 
 def test_kp_and_kd_of_a_surface_reach_bullet_and_a_softer_spring_sinks_deeper(clients,

@@ -49,7 +49,6 @@ import math
 import numpy as np
 import pybullet
 
-from . import wheel_contact
 from .parameters import ParameterReader
 from .part import SCHEDULE_SLACK, Part, PartContext, next_period_time
 from .transforms import Pose, cross
@@ -95,14 +94,16 @@ class DiffDrive(Part):
 
     @classmethod
     def build(cls, context: PartContext, plugin):
-        # the wheels' ground-contact spheres (wheel_contact), anchored while the robot stands
+        # anchored while the robot stands: the wheels' ground-contact spheres (wheel_contact)
+        # and every other link that may touch the ground (a caster, a skid), not the wheels'
+        # own cylinders, which never do
         joints = context.description.joints
-        anchor_links = []
+        wheels = set()
         for tag, default in (("leftJoint", "left_joint"), ("rightJoint", "right_joint")):
             joint = plugin.params.get(tag, default).strip()
-            contact = joints[joint][1] + wheel_contact.SUFFIX if joint in joints else None
-            if contact in context.links:
-                anchor_links.append(context.links[contact])
+            if joint in joints:
+                wheels.add(joints[joint][1])
+        anchor_links = [index for link, index in context.links.items() if link not in wheels]
         return cls(context.client, context.body_id, context.joints, plugin, context.warn,
                    command_timeout=context.command_timeout,
                    legacy_mode_swaps=context.legacy_mode_swaps,
@@ -312,9 +313,9 @@ class DiffDrive(Part):
                             targetVelocity=speed, force=self.wheel_torque)
 
     def _anchor(self, standing):
-        """Friction anchors on the wheels' ground contacts while the robot is told to stand
-        (see wheel_contact.FRICTION_ANCHOR): they stop the last sideways slip, and cost
-        about a third of a step while on, so a driving robot goes without."""
+        """Friction anchors on the robot's ground contacts (the wheels' and a caster's) while
+        it is told to stand (see wheel_contact.FRICTION_ANCHOR): they stop the last sideways
+        slip, and cost about a third of a step while on, so a driving robot goes without."""
         if standing == self._anchored:
             return
         self._anchored = standing

@@ -1,37 +1,34 @@
 """Reads a URDF robot description (the `robot_description` parameter, as xacro expands it) for
 what Gazebo would take from it beyond links and joints, and cleans it for pybullet's loader.
 
-- `parse_robot(urdf_xml, model_name)` -> `specs.RobotSpec`: the root link, the `<gazebo>`
+- `parse_robot(urdf_xml, model_name)` -> `specs.RobotSpec`: the root link and the `<gazebo>`
   tags (model plugins such as libgazebo_ros_diff_drive.so, ray sensors with their
-  libgazebo_ros_laser.so plugin, `<mu1>`/`<mu2>` per link) and the SDF-style
-  `<surface><friction><ode><mu>/<mu2>` written inside URDF `<collision>` elements.
+  libgazebo_ros_laser.so plugin, `<mu1>`/`<mu2>` and `<kp>`/`<kd>` per link).
   Anything it does not simulate becomes a warning naming the tag (`RobotSpec.warnings`);
   a description it cannot use raises `RobotDescriptionError` saying what and where. A
   plugin's or sensor's values are range-checked by the part that reads them, when it is
   built (engine/parameters.py's ParameterReader), not here.
 - `bullet_tree(spec)` -> a copy of the parsed URDF with only URDF elements left (no `<gazebo>`
-  blocks, no link `<pose>`, no collision `<surface>`), for `loadURDF`; `strip_for_bullet(spec)`
-  is the same as text.
+  blocks, no link `<pose>`, nothing but `<origin>` and `<geometry>` in a collision), for
+  `loadURDF`; `strip_for_bullet(spec)` is the same as text.
 The text is parsed once, by parse_robot; everything else reads the RobotSpec it returns (its
 `urdf` element tree, links and joints).
-- `effective_link_friction(spec)` -> one (mu1, mu2) per link, by the rule below.
+- `effective_link_friction(spec)` / `effective_link_contact(spec)` -> (mu1, mu2) / (kp, kd)
+  per link that `<gazebo reference>` gives them to.
 
-Friction rule. Bullet holds one friction per link, while a URDF link may have several
-collisions. For each link:
-1. `<gazebo reference="LINK">` `<mu1>`/`<mu2>` win: Gazebo applies them to every collision of
-   the link.
-2. Otherwise, if some of its collisions carry `<surface>` friction, the link gets the lowest
-   mu and the lowest mu2 among those collisions; collisions without `<surface>` do not count.
-   Such a collision is the part of the body meant to touch the ground (a caster or skid); the
-   rest of the body does not. m2wr: the chassis box rides 0.1 m above the ground and only its
-   caster sphere (mu = mu2 = 0) touches, so link_chassis gets (0, 0). This is a rule, not a
-   fault: no warning is given for it.
-3. Otherwise the link is not listed and takes Gazebo's default (mu = mu2 = 1).
-A value missing from a pair (`<mu1>` without `<mu2>`, `<mu>` without `<mu2>`) is 1, SDF's
-default. Contact stiffness and damping (`<gazebo reference>` `<kp>`/`<kd>`, or a collision's
-`<surface><contact><ode><kp>/<kd>`) follow the same rule (`effective_link_contact`; the
-softest collision's values), with SDF's defaults 1e12 N/m and 1 N s/m. Collision keys are (link name, collision name), or (link name, "N") for the N-th
-(0-based) collision of the link when it has no name.
+Friction and contact, as Gazebo takes them from a URDF. urdfdom reads a `<collision>` for its
+name, `<origin>` and `<geometry>` only, and sdformat's URDF-to-SDF conversion takes friction
+and contact values only from `<gazebo reference="LINK">` (`<mu1>`, `<mu2>`, `<kp>`, `<kd>`),
+for every collision of LINK. Anything else inside a `<collision>`, such as an SDF-style
+`<surface><friction><ode><mu>`, never reaches Gazebo: the stand-in ignores it too, with one
+warning per collision and element (Gazebo says nothing). m2wr's caster writes mu = mu2 = 0
+that way, so in Gazebo, and here, it has SDF's default mu = mu2 = 1. A link without
+`<gazebo reference>` values takes SDF's defaults: mu = mu2 = 1, kp 1e12 N/m, kd 1 N s/m; a
+value missing from a pair (`<mu1>` without `<mu2>`) is its default. Bullet holds one friction
+per link, which is exact here: Gazebo gives every collision of a link the same values.
+A URDF `<visual>` keeps its `<origin>`, `<geometry>` and `<material>` (the colour:
+appearance.py); anything else in it is dropped silently, as urdfdom drops it: nothing there
+changes the simulation.
 
 No pybullet here: plain XML (xml.etree) in, `specs` dataclasses and text out.
 """
@@ -132,11 +129,11 @@ def parse_robot(urdf_xml: str, model_name: str) -> RobotSpec:
     link_friction = {link: tuple(DEFAULT_MU if v is None else v for v in pair)
                      for link, pair in mu_given.items()}
     link_contact = {link: tuple(pair) for link, pair in contact_given.items()}
+    warnings.extend(_collision_extras(root, link_friction))
     return RobotSpec(name=model_name, root_link=root_link, plugins=tuple(plugins),
                      sensors=tuple(sensors), link_friction=link_friction,
-                     collision_friction=_collision_friction(root),
-                     link_contact=link_contact, collision_contact=_collision_contact(root),
-                     warnings=tuple(warnings), links=tuple(links), joints=joints, urdf=root)
+                     link_contact=link_contact, warnings=tuple(warnings), links=tuple(links),
+                     joints=joints, urdf=root)
 
 
 def bullet_tree(spec: RobotSpec) -> ET.Element:
@@ -172,34 +169,16 @@ def driven_wheel_links(spec: RobotSpec, plugin_keys) -> set:
 
 
 def effective_link_contact(spec: RobotSpec) -> Dict[str, Tuple[float, float]]:
-    """(kp, kd) for every link the description gives a contact stiffness or damping: the
-    link's <gazebo> kp/kd, else the softest (lowest kp, highest kd) of its collisions'
-    <surface><contact><ode> values; a value not given anywhere is SDF's default."""
-    result: Dict[str, list] = {}
-    for (link, _), (kp, kd) in spec.collision_contact.items():
-        pair = result.setdefault(link, [None, None])
-        if kp is not None:
-            pair[0] = kp if pair[0] is None else min(kp, pair[0])
-        if kd is not None:
-            pair[1] = kd if pair[1] is None else max(kd, pair[1])
-    for link, (kp, kd) in spec.link_contact.items():
-        pair = result.setdefault(link, [None, None])
-        pair[0] = kp if kp is not None else pair[0]
-        pair[1] = kd if kd is not None else pair[1]
+    """(kp, kd) for every link whose <gazebo reference> gives a <kp> or <kd>; the other value
+    of the pair, when not given, is SDF's default."""
     return {link: (DEFAULT_KP if kp is None else kp, DEFAULT_KD if kd is None else kd)
-            for link, (kp, kd) in result.items()}
+            for link, (kp, kd) in spec.link_contact.items()}
 
 
 def effective_link_friction(spec: RobotSpec) -> Dict[str, Tuple[float, float]]:
-    """(mu1, mu2) for every link the description gives a friction, by the module's rule:
-    the link's <gazebo> mu1/mu2, else the lowest <surface> values of its collisions."""
-    result: Dict[str, Tuple[float, float]] = {}
-    for (link, _), (mu, mu2) in spec.collision_friction.items():
-        if link in result:
-            mu, mu2 = min(mu, result[link][0]), min(mu2, result[link][1])
-        result[link] = (mu, mu2)
-    result.update(spec.link_friction)
-    return result
+    """(mu1, mu2) for every link whose <gazebo reference> gives a <mu1> or <mu2>; other links
+    have SDF's default, mu = mu2 = 1 (see the module docstring)."""
+    return dict(spec.link_friction)
 
 
 # --- helpers -----------------------------------------------------------------------------
@@ -428,39 +407,28 @@ def _ray_sensor(sensor, link, warnings):
     return dataclasses.replace(spec, plugin=plugin)
 
 
-def _collision_friction(root):
-    result = {}
+def _collision_extras(root, link_friction):
+    """One warning per collision and element for what a URDF <collision> holds besides
+    <origin> and <geometry>: Gazebo never reads it (see the module docstring)."""
+    warnings = []
     for link in root.findall("link"):
+        name = link.get("name")
+        if name in link_friction:
+            friction = "mu1 = %g, mu2 = %g (its <gazebo reference>)" % link_friction[name]
+        else:
+            friction = "mu = mu2 = 1 (SDF's default)"
         for index, collision in enumerate(link.findall("collision")):
-            ode = collision.find("surface/friction/ode")
-            if ode is None:
-                continue
-            key = (link.get("name"), collision.get("name") or str(index))
-            where = "link '%s' collision '%s' <surface><friction><ode>" % key
-            mu = _number(ode, "mu", where, None)
-            mu2 = _number(ode, "mu2", where, None)
-            if mu is None and mu2 is None:
-                continue
-            result[key] = (DEFAULT_MU if mu is None else mu, DEFAULT_MU if mu2 is None else mu2)
-    return result
-
-
-def _collision_contact(root):
-    result = {}
-    for link in root.findall("link"):
-        for index, collision in enumerate(link.findall("collision")):
-            ode = collision.find("surface/contact/ode")
-            if ode is None:
-                continue
-            key = (link.get("name"), collision.get("name") or str(index))
-            where = "link '%s' collision '%s' <surface><contact><ode>" % key
-            kp = _number(ode, "kp", where, None)
-            kd = _number(ode, "kd", where, None)
-            if kp is None and kd is None:
-                continue
-            result[key] = (None if kp is None else _contact_value("kp", kp, where),
-                           None if kd is None else _contact_value("kd", kd, where))
-    return result
+            which = ("collision '%s'" % collision.get("name") if collision.get("name")
+                     else "collision %d (unnamed, counted from 0)" % index)
+            for tag in dict.fromkeys(child.tag for child in collision
+                                     if child.tag not in _URDF_CHILDREN["collision"]):
+                warnings.append(
+                    "link '%s' %s: <%s> is ignored, as in Gazebo: a URDF <collision> is read "
+                    "for its name, <origin> and <geometry> only, so this collision has the "
+                    "link's friction, %s. To set friction or contact values, use "
+                    "<gazebo reference=\"%s\"> with <mu1>/<mu2> (<kp>/<kd>) instead"
+                    % (name, which, tag, friction, name))
+    return warnings
 
 
 def _contact_value(tag, value, where):

@@ -143,13 +143,10 @@ class RobotSpec:
     root_link: str
     plugins: Tuple[PluginSpec, ...] = ()
     sensors: Tuple[RaySensorSpec, ...] = ()
-    link_friction: Dict[str, Tuple[float, float]] = field(default_factory=dict)  # link: (mu1, mu2)
-    collision_friction: Dict[Tuple[str, str], Tuple[float, float]] = field(default_factory=dict)
+    # link: (mu1, mu2) from <gazebo reference> <mu1>/<mu2> (a missing one is 1, SDF's default)
+    link_friction: Dict[str, Tuple[float, float]] = field(default_factory=dict)
     # link: (kp [N/m], kd [N s/m]) from <gazebo reference> <kp>/<kd>, each None when not given
     link_contact: Dict[str, Tuple[Optional[float], Optional[float]]] = field(default_factory=dict)
-    # (link, collision): (kp, kd) from <surface><contact><ode>, each None when not given
-    collision_contact: Dict[Tuple[str, str], Tuple[Optional[float], Optional[float]]] = field(
-        default_factory=dict)
     warnings: Tuple[str, ...] = ()
     links: Tuple[str, ...] = ()               # link names, in file order
     joints: Dict[str, Tuple[str, str]] = field(default_factory=dict)   # name: (parent, child)

@@ -22,13 +22,14 @@ coefficients, clamped to 10. Products cannot equal minima for every pair, so:
 - every body gets `bullet_friction(mu)` = min(mu, 1). The product of two such coefficients is
   min(mu_a, mu_b) whenever one mu is at most 1 and the other at least 1, or one is 0
   (`exact_pair`). Gazebo's default is 1, so every pair with a default surface is exact; in
-  the tutorial's worlds all are (ground 100, walls and barrels 1, wheels 1, caster 0).
+  the tutorial's worlds all are (ground 100, walls and barrels 1, m2wr's wheels and caster 1:
+  the caster's mu 0 is written where Gazebo never reads it, see robot_description).
   Before this module, bodies took their mu as it was: wheel 1 x ground 100 gave 100, clamped
   to 10, where Gazebo has 1.
 - the wheels' ground-contact spheres (wheel_contact) touch nothing but the ground, so theirs
   is chosen to make the pair exact for any values: min(mu_wheel, mu_ground) / f_ground.
 - mu2: Bullet's friction is isotropic; mu is used. (The tutorial's surfaces give the same
-  minimum for mu and mu2: ground (100, 50) against (1, 1) or (0, 0).)
+  minimum for mu and mu2: ground (100, 50) against (1, 1).)
 No pybullet import: pure rules; `apply` takes the client.
 """
 from dataclasses import dataclass
