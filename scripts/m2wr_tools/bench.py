@@ -3,6 +3,7 @@ obstacle_avoidance.py), printed side by side and written to <output>/bench.json.
 
   scripts/bench.sh [--seconds 15] [--soak MINUTES] [--clock-hz 20] [--output output/]
   scripts/bench.sh --listeners-only ROUNDS [--seconds 15] [--watch-rate HZ]
+  scripts/bench.sh --loop-program-only [--seconds 15]
 
 Figures:
   whole loop        real-time factor of simulator + obstacle_avoidance.py, headless, with
@@ -11,6 +12,11 @@ Figures:
                     the simulator and of the controller per sim second; how often the robot
                     touched a model (free-running, the controller's answers come late in sim
                     time and the robot hits barriers: the reason lockstep exists)
+  loop program      the same lockstep loop with obstacle_avoidance.py's rules driven by a
+                    rospy.Rate(20) loop of their own (m2wr_tools/loop_avoidance.py), at the
+                    demo's /clock rate (the batch runner's) and at the simulator's default
+                    100 Hz (the world launch's): its x real time over obstacle_avoidance.py's
+                    at the same clock (target >= 0.8)
   lockstep check    scans published vs cmd_vel answers over a window that starts and ends
                     paused (so no answer is in flight at either edge)
   physics alone     the engine only (no ROS), world02 + m2wr: Bullet's stepSimulation, and
@@ -71,13 +77,15 @@ import sys
 from . import benchmath
 from .processes import Interrupted, raise_on_signals
 from .bench_engine import engine_figures
-from .bench_loop import WORLD, START, Listener, launch_to_first_scan, measure_loop, say, soak
+from .bench_loop import (LOOP_PROGRAM, WORLD, START, Listener, launch_to_first_scan, measure_loop,
+                         say, soak)
 from .benchmath import fmt
 from .paths import ROOT
 from .session import Session, SessionError
 
 SIMULATOR_DEFAULT_CLOCK_HZ = 100.0
 UNLIMITED = "listeners, watch_rate 0"
+LOOP = "loop program"       # suffix of the loop program's columns (loop_avoidance.py)
 
 
 # --- the report ---------------------------------------------------------------------------
@@ -132,6 +140,9 @@ def report(figures):
         "  lockstep loop / World.step alone         %s %% (target >= 60 %%)" % (
             fmt(100.0 * lockstep / step_alone if lockstep and step_alone else None, "%.0f")),
     ]
+    for label, ratio in loop_program_ratios(loops):
+        lines.append("  loop program / obstacle_avoidance.py, %s  %s (target >= 0.8)"
+                     % (label, fmt(ratio, "%.2f")))
     launch = figures.get("launch")
     if launch:
         lines.append("launch to first scan                  %6.2f s (simulator ready at %s s)" % (
@@ -171,9 +182,31 @@ def whole_bench(session, listener, args, figures):
         loops["lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ] = measure_loop(
             session, listener, "lockstep /clock %g Hz" % SIMULATOR_DEFAULT_CLOCK_HZ, True,
             SIMULATOR_DEFAULT_CLOCK_HZ, args.seconds, args.check_seconds)
+    loop_program_columns(session, listener, args, loops)
     figures["launch"] = launch_to_first_scan(session, listener, args.clock_hz)
     if args.soak > 0:
         figures["soak"] = soak(session, listener, args.soak, args.clock_hz)
+
+
+def loop_program_columns(session, listener, args, loops):
+    """The loop program in lockstep at the batch runner's /clock rate (--clock-hz) and at the
+    world launch's default, each beside obstacle_avoidance.py's column of the same clock."""
+    for clock_hz in sorted({args.clock_hz, SIMULATOR_DEFAULT_CLOCK_HZ}):
+        name = "lockstep%s, %s" % ("" if clock_hz == args.clock_hz else " /clock %g Hz"
+                                   % clock_hz, LOOP)
+        loops[name] = measure_loop(session, listener, name, True, clock_hz, args.seconds,
+                                   args.check_seconds, controller=LOOP_PROGRAM)
+
+
+def loop_program_ratios(loops):
+    """[(label, loop program x real time / obstacle_avoidance.py's)] for each clock rate."""
+    ratios = []
+    for name, result in loops.items():
+        if name.endswith(", " + LOOP):
+            answering = loops.get(name[:-len(", " + LOOP)], {}).get("x_real_time")
+            ratios.append((name[:-len(", " + LOOP)], result["x_real_time"] / answering
+                           if answering and result["x_real_time"] else None))
+    return ratios
 
 
 def listener_rounds(session, listener, args):
@@ -229,6 +262,9 @@ def parse_args(argv):
                         help="only the lockstep loop without and with listeners, ROUNDS times "
                              "in turn (the listener target's ratio per round and its median); "
                              "no engine, free-running or launch figures")
+    parser.add_argument("--loop-program-only", action="store_true",
+                        help="only obstacle_avoidance.py and the loop program in lockstep, at "
+                             "--clock-hz and at 100 Hz, and their ratios (issue 26's target)")
     parser.add_argument("--watch-rate", type=float, default=None, metavar="HZ",
                         help="with --listeners-only: the simulator's ~watch_rate (default: its "
                              "own, 30)")
@@ -279,6 +315,14 @@ def main(argv=None):
         listener = Listener()
         if args.listeners_only:
             figures["listener_rounds"] = listener_rounds(session, listener, args)
+        elif args.loop_program_only:
+            loops = figures["loop"]
+            for clock_hz in sorted({args.clock_hz, SIMULATOR_DEFAULT_CLOCK_HZ}):
+                name = "lockstep" if clock_hz == args.clock_hz else "lockstep /clock %g Hz" \
+                    % clock_hz
+                loops[name] = measure_loop(session, listener, name, True, clock_hz,
+                                           args.seconds, args.check_seconds)
+            loop_program_columns(session, listener, args, loops)
         else:
             whole_bench(session, listener, args, figures)
     except SessionError as err:
@@ -301,6 +345,13 @@ def main(argv=None):
         print(rounds_report(figures), flush=True)
     if "engine" in figures:
         print(report(figures) if figures["loop"] else "", flush=True)
+    elif args.loop_program_only:
+        for label, ratio in loop_program_ratios(figures["loop"]):
+            print("loop program / obstacle_avoidance.py, %s: %s x real time / %s = %s "
+                  "(target >= 0.8)" % (label, fmt(figures["loop"][label + ", " + LOOP]
+                                                 ["x_real_time"]),
+                                       fmt(figures["loop"][label]["x_real_time"]),
+                                       fmt(ratio, "%.2f")), flush=True)
     say("figures written to %s" % path)
     return status
 

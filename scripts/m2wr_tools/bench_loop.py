@@ -4,6 +4,7 @@ bench's own node listens on /clock, /gazebo/contacts, and while counting on the 
 /cmd_vel and /rosout."""
 import os
 import re
+import sys
 import threading
 import time
 
@@ -116,11 +117,16 @@ def wait_counting(session, timeout=10.0):
     raise SessionError("the bench's counters did not connect within %.0f s" % timeout)
 
 
-def start_loop(session, lockstep, clock_hz, extra=()):
-    """Simulator (paused) + m2wr + obstacle_avoidance.py connected, ready to unpause;
-    `extra`: more arguments of the world's launch file."""
+# obstacle_avoidance.py's rules on a rospy.Rate(20) loop of their own (loop_avoidance.py)
+LOOP_PROGRAM = (sys.executable, "-m", "m2wr_tools.loop_avoidance")
+
+
+def start_loop(session, lockstep, clock_hz, extra=(), controller=None):
+    """Simulator (paused) + m2wr + obstacle_avoidance.py (or `controller`, an argv)
+    connected, ready to unpause; `extra`: more arguments of the world's launch file."""
+    more = {} if controller is None else {"controller": controller}
     session.start_episode(WORLD, START, lockstep=lockstep, real_time_factor=0.0, seed=0,
-                          pub_clock_frequency=clock_hz, extra=extra)
+                          pub_clock_frequency=clock_hz, extra=extra, **more)
     return session.node_pid(SIMULATOR_NODE), session.children["controller"].pid
 
 
@@ -154,11 +160,12 @@ def stop_loop(session):
 
 
 def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_seconds, warmup=2.0,
-                 watchers=False, extra=()):
-    say("%s: simulator real_time_factor 0, lockstep %s, /clock %g Hz%s%s" % (
+                 watchers=False, extra=(), controller=None):
+    say("%s: simulator real_time_factor 0, lockstep %s, /clock %g Hz%s%s%s" % (
         name, str(lockstep).lower(), clock_hz, ", with listeners" if watchers else "",
-        "".join(", " + arg for arg in extra)))
-    sim_pid, ctrl_pid = start_loop(session, lockstep, clock_hz, extra)
+        "".join(", " + arg for arg in extra),
+        ", the loop program (loop_avoidance.py)" if controller else ""))
+    sim_pid, ctrl_pid = start_loop(session, lockstep, clock_hz, extra, controller)
     try:
         if watchers:
             start_watchers(session)
@@ -194,7 +201,7 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         missing = benchmath.missing_periods(listener.scan_stamps[before[0]:after[0]], SCAN_PERIOD)
         peak = processes.peak_rss_kib(sim_pid)
         with open(session.children["world"].log_path, errors="replace") as log:
-            timeouts = sum("lockstep: no cmd_vel" in line for line in log)
+            timeouts = sum("lockstep: " in line and "still at work" in line for line in log)
     finally:
         stop_loop(session)
     result = {

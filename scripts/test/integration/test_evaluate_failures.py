@@ -34,16 +34,34 @@ def test_crashing_and_silent_controllers_fail_their_runs_not_the_batch(tmp_path,
     no_process_left(data)
 
 
-def test_a_hung_controller_is_failed_by_the_run_timeout(tmp_path, run_evaluate,
-                                                        no_process_left):
+def test_a_hung_controller_does_not_hold_the_simulator(tmp_path, run_evaluate,
+                                                       no_process_left):
+    """Blocked for ever after its first answer, it is asleep: lockstep's barrier does not
+    wait for it, the run goes its full length and fails because the robot stood still."""
     status, text, data = run_evaluate(
         ["--controller", os.path.join(FIXTURES, "hung_controller.py"), "--workers", "1",
-         "--run-timeout", "6"], tmp_path / "hung")
+         "--duration", "10", "--run-timeout", "60"], tmp_path / "hung")
+    assert status == 0, text
+    [r] = data["runs"]
+    assert r["success"] is False
+    assert r["reason"].startswith("travelled 0.00 m, under the 1.00 m asked"), r["reason"]
+    assert r["cmd_vel_messages"] >= 1            # it did answer once
+    assert r["sim_time_s"] >= 9.9                # the whole run (its last step), not held
+    no_process_left(data)
+
+
+def test_a_slow_controller_is_failed_by_the_run_timeout(tmp_path, run_evaluate,
+                                                        no_process_left):
+    """50 ms of CPU per scan: lockstep waits for each answer (about 1x real time), and the
+    run's wall-time limit fails it, naming the controller's log."""
+    status, text, data = run_evaluate(
+        ["--controller", os.path.join(FIXTURES, "slow_controller.py"), "--workers", "1",
+         "--run-timeout", "6"], tmp_path / "slow")
     assert status == 0, text
     [r] = data["runs"]
     assert r["success"] is False
     assert r["reason"].startswith("did not finish within 6 s of wall time"), r["reason"]
     assert r["controller_log"] in r["reason"] and os.path.exists(r["controller_log"])
-    assert r["cmd_vel_messages"] >= 1            # it did answer once
+    assert r["cmd_vel_messages"] >= 1
     assert r["sim_time_s"] < 20.0                # lockstep held the simulator for it
     no_process_left(data)

@@ -77,9 +77,17 @@ class Binding:
         """The nodes that command this part or read its sensor or odometry topics: they may
         act on what they get in sim time (a controller, bug2's supervisor), where a display
         only shows it; see clock_topic.py."""
-        commanders = {c.callerid_pub for s in self.subscribers if s.impl is not None
-                      for c in list(s.impl.connections)}
-        return commanders.union(*(p.subscriber_nodes() for p in self.loop_publishers))
+        return {node for node, _ in self.loop_connections()}
+
+    def loop_connections(self) -> list:
+        """[(node name, rospy connection)] of the loop nodes' connections to this part."""
+        pairs = [(c.callerid_pub, c) for s in self.subscribers if s.impl is not None
+                 for c in list(s.impl.connections)]
+        for publisher in self.loop_publishers:
+            impl = publisher.publisher.impl
+            if impl is not None:
+                pairs.extend((c.endpoint_id, c) for c in list(impl.connections))
+        return pairs
 
     def close(self):
         for subscriber in self.subscribers:
@@ -192,6 +200,9 @@ class RobotBindings:
 
     def loop_nodes(self) -> set:
         return set().union(*(b.loop_nodes() for b in self.by_part.values()))
+
+    def loop_connections(self) -> list:
+        return [pair for b in self.by_part.values() for pair in b.loop_connections()]
 
     def close(self):
         for binding in self.by_part.values():

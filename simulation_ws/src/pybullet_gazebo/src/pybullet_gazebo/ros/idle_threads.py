@@ -16,7 +16,11 @@ Why "all threads asleep" means "done with what it was sent":
   process holds the GIL, and that one is R (a thread that releases the GIL wakes the next
   before it sleeps itself);
 - a controller's command travels the same way back: once its process is idle, the command
-  is in the simulator's socket or being read there (OwnReceivers checks that side).
+  is in the simulator's socket or being read there (OwnReceivers checks that side);
+- except that the kernel may leave a loopback packet in a CPU's input backlog, for its
+  ksoftirqd thread to deliver later (on a loaded machine): until then no reader is woken.
+  So nobody is idle while a backlog holds packets (/proc/net/softnet_stat's backlog
+  column, Linux 5.10 and later; on older kernels this check is skipped).
 
 Busy loops. A thread that never sleeps (the series' go_to_point spins in
 `while not rospy.is_shutdown(): if not active_: continue` while switched off) is never idle.
@@ -182,6 +186,36 @@ class ProcessThreads:
         self.threads.clear()
 
 
+def _backlog_column():
+    """The index of softnet_stat's backlog length, or None where the kernel has none."""
+    try:
+        with open("/proc/net/softnet_stat", "rb") as f:
+            columns = len(f.readline().split())
+    except OSError:
+        return None
+    return 11 if columns >= 13 else None
+
+
+class KernelBacklog:
+    """Packets in the CPUs' input backlogs, not yet delivered to any socket."""
+
+    def __init__(self):
+        self.column = _backlog_column()
+        self._fd = os.open("/proc/net/softnet_stat", os.O_RDONLY) \
+            if self.column is not None else None
+
+    def packets(self):
+        if self._fd is None:
+            return 0
+        data = os.pread(self._fd, 4096, 0)
+        return sum(int(line.split()[self.column], 16) for line in data.splitlines())
+
+    def close(self):
+        if self._fd is not None:
+            os.close(self._fd)
+            self._fd = None
+
+
 class IdleWatch:
     """Waits until a set of processes is idle (see the module docstring)."""
 
@@ -189,6 +223,7 @@ class IdleWatch:
 
     def __init__(self, own_busy=lambda: False):
         self.own_busy = own_busy            # the simulator's own side (OwnReceivers.busy)
+        self.backlog = KernelBacklog()
         self._processes = {}                # pid -> ProcessThreads
         self._round_start = 0.0             # [s] monotonic: when the present wait began
 
@@ -212,11 +247,14 @@ class IdleWatch:
 
     def busy(self, new_round=True):
         """(pid, tid) of a thread still at work, ("self", None) for the simulator's own
-        receivers, or None when all are idle. Processes that ended are dropped.
+        receivers, ("kernel", n) for n packets not yet delivered, or None when all are idle. Processes that ended are dropped.
         `new_round`: this look starts a wait (see the module docstring on busy loops)."""
         now = time.monotonic()
         if new_round:
             self._round_start = now
+        packets = self.backlog.packets()
+        if packets:
+            return "kernel", packets
         for pid, process in list(self._processes.items()):
             tid = process.busy_thread(now, self._round_start)
             if tid is False:
@@ -244,3 +282,4 @@ class IdleWatch:
 
     def close(self):
         self.watch(())
+        self.backlog.close()

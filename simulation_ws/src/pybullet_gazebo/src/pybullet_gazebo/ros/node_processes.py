@@ -60,6 +60,12 @@ class NodeProcesses:
             self._pids = {n: p for n, p in self._pids.items() if n in names}
         return found
 
+    def forget(self):
+        """Every id found so far is asked again when next wanted."""
+        self._pids.clear()
+        self._unknown.clear()
+        self.remote.clear()
+
     def pid_of(self, name):
         """The process id found for node `name`, or "not found"."""
         return self._pids.get(name, "on another machine" if name in self.remote else "unknown")

@@ -87,7 +87,7 @@ class SimulatorNode:
                 "on (lockstep_timeout; counted in the run summary)" % (who,
                                                                      params.lockstep_timeout)))
         self._loop_clock = None                   # lockstep: /clock the loop nodes still owe
-        self._watched_names = None                # lockstep: the loop nodes watched now
+        self._watched_key = None                  # lockstep: the loop connections watched now
         self._bindings = {}                       # robot name -> RobotBindings
         self._running = False                     # run() is stepping
         self._tf_publisher = None
@@ -237,13 +237,7 @@ class SimulatorNode:
         False when physics was paused meanwhile."""
         if not (self.lockstep.unsettled or self._loop_clock is not None):
             return True
-        names = self._loop_nodes()
-        if names != self._watched_names:
-            self._watched_names = names
-            self.lockstep.watch.watch(self._node_processes.pids(names))
-            rospy.loginfo("lockstep: waits for %s", ", ".join(
-                "%s (pid %s)" % (n, self._node_processes.pid_of(n)) for n in sorted(names))
-                or "no controller")
+        self._watch_loop_nodes()
         if not self.lockstep.settle():
             return False
         if self._loop_clock is not None:
@@ -253,10 +247,29 @@ class SimulatorNode:
             return self.lockstep.settle()
         return True
 
+    def _watch_loop_nodes(self):
+        """Lockstep watches the processes of the loop nodes. Their ids are asked again
+        whenever the loop nodes' connections change: a node restarted under the same name
+        (the batch runner's next controller) is a new process."""
+        connections = [pair for b in list(self._bindings.values())
+                       for pair in b.loop_connections()]
+        key = frozenset(connection for _, connection in connections)   # (held: no id reuse)
+        if key == self._watched_key:
+            return
+        self._watched_key = key
+        names = {node for node, _ in connections}
+        self._node_processes.forget()
+        self.lockstep.watch.watch(self._node_processes.pids(names))
+        rospy.loginfo("lockstep: waits for %s", ", ".join(
+            "%s (pid %s)" % (n, self._node_processes.pid_of(n)) for n in sorted(names))
+            or "no controller")
+
     def _describe_busy(self, busy):
         pid, _ = busy
         if pid == "self":
             return "the simulator's own reader of a message"
+        if pid == "kernel":
+            return "the kernel's delivery of packets"
         names = [n for n, p in self._node_processes._pids.items() if p == pid]
         return "node %s (pid %d)" % (names[0], pid) if names else "pid %s" % pid
 

@@ -1,0 +1,35 @@
+"""The tutorial's obstacle_avoidance.py driven by a loop of its own, as learners often rewrite
+it: the scan callback only keeps the latest scan; a rospy.Rate loop (~rate [Hz], default 20)
+hands it to the tutorial's clbk_laser, whose take_action publishes /cmd_vel and logs the
+case. Same node name (reading_laser), topics, rules and log lines as the tutorial's program;
+only what makes it act differs. The benchmark measures lockstep with it beside the tutorial's
+own program (a loop program against a scan-answering one).
+
+    python -m m2wr_tools.loop_avoidance [_rate:=20]
+"""
+import rospy
+from geometry_msgs.msg import Twist
+from sensor_msgs.msg import LaserScan
+
+from .tutorial import load_tutorial_program
+
+
+def main():
+    tutorial = load_tutorial_program("obstacle_avoidance.py")
+    rospy.init_node("reading_laser")
+    rate = rospy.Rate(rospy.get_param("~rate", 20.0))
+    tutorial.pub = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
+    latest = []
+    rospy.Subscriber("/m2wr/laser/scan", LaserScan, lambda msg: latest[:1].clear()
+                     or latest.append(msg))
+    try:
+        while not rospy.is_shutdown():
+            if latest:
+                tutorial.clbk_laser(latest[-1])
+            rate.sleep()
+    except rospy.ROSInterruptException:
+        pass
+
+
+if __name__ == "__main__":
+    main()
