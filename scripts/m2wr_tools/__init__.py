@@ -12,7 +12,14 @@
   picture      the top-down picture of a run
   benchmath    the benchmark's arithmetic and table
   demo, bench  the command lines behind demo.sh and bench.sh (bench_engine, bench_loop)
+  tutorial_scripts  motion_plan's scripts (the tutorial's programs) loaded as modules
+  gym_bench    m2wr_gym's speed figures: `python -m m2wr_tools.gym_bench`
+  gym_evaluate a policy against obstacle_avoidance.py in process, through m2wr_gym's env:
+               `python -m m2wr_tools.gym_evaluate`
 
 Geometry (poses, quaternions, yaw) is the engine's: pybullet_gazebo.engine.transforms.
+The tools stand above the project's ROS packages and use them, never the other way round:
+pybullet_gazebo (the engine), m2wr_gym (the environments), motion_plan (its scripts, run by
+rosrun or loaded by tutorial_scripts), my_worlds, m2wr_description, gazebo_msgs.
 Installed editable by scripts/setup.sh (scripts/pyproject.toml).
 """

@@ -1,18 +1,17 @@
-"""Fixtures for the unit tests of the tutorial's scripts (pytest, no ROS master).
+"""Fixtures for the unit tests of motion_plan's scripts (pytest, no ROS master).
 
-The scripts live in ../../scripts and are not a Python package, so they are loaded by path
-with importlib, a fresh module object per test (obstacle_avoidance keeps its publisher in a
-module global). `rospy.loginfo` is replaced to capture what the scripts log.
+The scripts live in ../../scripts and are not a Python package: they are loaded by path
+through m2wr_tools.tutorial_scripts (found with rospkg, as rosrun finds them), a fresh
+module object per test (obstacle_avoidance keeps its publisher in a module global).
+`rospy.loginfo` is replaced to capture what the scripts log.
 """
-import importlib.util
 import math
-from pathlib import Path
 
 import pytest
 import rospy
+from m2wr_tools import tutorial_scripts
 from sensor_msgs.msg import LaserScan
 
-SCRIPTS_DIR = Path(__file__).resolve().parents[2] / "scripts"
 BEAMS = 720  # m2wr's laser: 720 samples from -90 to +90 deg, index 0 on the right
 
 
@@ -20,15 +19,7 @@ BEAMS = 720  # m2wr's laser: 720 samples from -90 to +90 deg, index 0 on the rig
 def load_script():
     """Returns load(file_name): the script executed as a fresh module, not registered in
     sys.modules, and without running its main()."""
-    def load(file_name):
-        path = SCRIPTS_DIR / file_name
-        if not path.is_file():
-            raise FileNotFoundError(f"tutorial script not found: {path}")
-        spec = importlib.util.spec_from_file_location(path.stem, path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        return module
-    return load
+    return tutorial_scripts.load
 
 
 @pytest.fixture

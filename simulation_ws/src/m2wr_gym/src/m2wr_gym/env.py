@@ -229,6 +229,13 @@ class M2wrEnv(gymnasium.Env):
         title = "%s, t = %.1f s" % (self.options.task, s.sim_time if s else 0.0)
         return self._picture.draw(self._path or [], scan, self._goal, title)
 
+    @property
+    def snapshot(self):
+        """What the robot senses and where it is after the last reset or step (the backend's
+        Snapshot: the whole scan [m], x, y [m], yaw [rad], sim_time [s], touched); None
+        before the first reset."""
+        return self._snapshot
+
     def clearance(self, within=np.inf):
         """Smallest distance [m] from m2wr's footprint to an obstacle's, now (0 = touching;
         inf when nothing is within `within` [m])."""

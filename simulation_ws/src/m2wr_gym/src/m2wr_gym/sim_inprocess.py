@@ -64,6 +64,11 @@ class InProcessSim:
         self._laser_last = None
         self._ahead = None        # (steps, touched, readings) run_ahead did of the next run
 
+    @property
+    def drive(self):
+        """m2wr's DiffDrive in the current world (None before the first reset)."""
+        return self._drive
+
     def reset(self, x, y, yaw, seed):
         """A fresh world with m2wr at (x, y, yaw) at rest; ValueError naming the pose when it
         is inside an obstacle. Returns the first scan (taken at sim time 0)."""

@@ -124,6 +124,11 @@ def read_monitor(paths):
     return steps, np.array([r[2] for r in rows])
 
 
+def duration(seconds):
+    """A wall time for a title: seconds under a minute, else minutes ("17 s", "49 min")."""
+    return "%.0f s" % seconds if seconds < 59.5 else "%.0f min" % (seconds / 60.0)
+
+
 def plot_curve(steps, returns, path, title):
     import matplotlib
     matplotlib.use("Agg")
@@ -229,15 +234,17 @@ def main(argv=None):
     finally:
         venv.close()
     wall = time.monotonic() - started
-    model.save(os.path.join(args.out, "model.zip"))
+    model_path = os.path.join(args.out, "model.zip")
+    model.save(model_path)
     policy_path = os.path.join(args.out, "policy.npz")
     export(model, kwargs, args, dt, policy_path)
     steps, returns = read_monitor(monitors)
     curve = os.path.join(args.out, "learning_curve.png")
-    plot_curve(steps, returns, curve, "%s %s, %s, %d steps in %.0f min wall time"
+    plot_curve(steps, returns, curve, "%s %s, %s, %d steps in %s wall time"
                % (args.algo.upper(), args.task, args.world, int(steps[-1]) if len(steps) else 0,
-                  wall / 60.0))
-    print("[train] done in %.0f s: %s, %s" % (wall, policy_path, curve), flush=True)
+                  duration(wall)))
+    written = [policy_path, curve, model_path] + monitors
+    print("[train] done in %.0f s; wrote %s" % (wall, ", ".join(written)), flush=True)
     return 0
 
 

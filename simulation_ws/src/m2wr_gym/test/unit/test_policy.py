@@ -1,6 +1,6 @@
 """The deploy path with numpy only: a policy exported to .npz loads and acts the same, files
-of the wrong shape are refused naming the file, the ROS node's decision cadence and checks,
-and the shipped policy."""
+of the wrong shape are refused naming the file, and the shipped policy. (The ROS node that
+runs it, motion_plan/scripts/learned_avoidance.py, is tested in motion_plan's unit tests.)"""
 import os
 import subprocess
 import sys
@@ -8,11 +8,10 @@ import sys
 import numpy as np
 import pytest
 
-from m2wr_gym import actions, observation, resources
+from m2wr_gym import actions, resources
 from m2wr_gym.policy import NumpyPolicy, PolicyFileError, load
 
 SHIPPED = os.path.join(resources.package_path("m2wr_gym"), "policies", "avoid_world02.npz")
-NODE_DIR = os.path.join(resources.package_path("motion_plan"), "scripts")
 
 
 def small_policy(rng, n_in=5, hidden=8):
@@ -74,48 +73,6 @@ def test_missing_and_foreign_files_are_named(tmp_path):
     junk.write_text("not numpy")
     with pytest.raises(PolicyFileError, match="junk.npz is not a numpy .npz"):
         load(str(junk))
-
-
-class _Msg:
-    def __init__(self, stamp, ranges):
-        class _Stamp:
-            def to_sec(self_inner):
-                return stamp
-        self.header = type("H", (), {"stamp": _Stamp()})()
-        self.ranges = ranges
-        self.range_max = 10.0
-
-
-def test_node_decides_every_control_period_and_answers_every_scan(monkeypatch):
-    sys.path.insert(0, NODE_DIR)
-    try:
-        import learned_avoidance as node_module
-    finally:
-        sys.path.remove(NODE_DIR)
-    published = []
-
-    class Node(node_module.LearnedAvoidance):
-        def __init__(self, policy):           # no ROS: the decision logic only
-            self.policy, self.command = policy, (0.0, 0.0)
-            self.next_decision, self.last_stamp = None, None
-
-        def publish(self, v, w):
-            published.append((v, w))
-    decisions = []
-    policy = small_policy(np.random.default_rng(3))
-    original = policy.command
-    policy.command = lambda o: decisions.append(o) or original(o)
-    node = Node(policy)
-    ranges = [1.0] * 720
-    for k in range(6):                        # scans every 0.05 s: a decision every 0.1 s
-        node.on_scan(_Msg(0.005 + 0.05 * k, ranges))
-    assert len(published) == 6 and len(decisions) == 3
-    assert np.allclose(decisions[0], observation.regions(np.ones(720)))
-    node.on_scan(_Msg(0.005, ranges))         # the simulation was reset: decide at once
-    assert len(decisions) == 4
-    goal_policy = small_policy(np.random.default_rng(4), n_in=7)
-    with pytest.raises(PolicyFileError, match="takes 7 inputs.*gives 5"):
-        node_module.check(goal_policy)
 
 
 def wall_ahead(d):

@@ -206,6 +206,14 @@ class DiffDrive(Part):
         self._fresh = True
         return True
 
+    def _command_at(self, sim_time):
+        """The command an update at sim_time [s] applies: the last one, or a stop when
+        command_timeout > 0 and no command came within it (or none came since the reset)."""
+        if self.command_timeout > 0 and (self._command_time is None or
+                                         sim_time - self._command_time > self.command_timeout):
+            return 0.0, 0.0
+        return self.command
+
     def next_command_time(self):
         """Sim time [s] of the next update, at which a command is read; a command set before
         the step that starts at this time takes effect then."""
@@ -251,10 +259,7 @@ class DiffDrive(Part):
         if not self._control.take(sim_time):
             return
         elapsed = sim_time - previous if previous is not None and sim_time > previous else dt
-        v, w = self.command
-        if self.command_timeout > 0 and (self._command_time is None or
-                                         sim_time - self._command_time > self.command_timeout):
-            v, w = 0.0, 0.0
+        v, w = self._command_at(sim_time)
         targets = [s * self.wheel_radius for s in self.wheel_speeds(v, w)]   # [m/s]
         for i, target in enumerate(targets):
             if self.wheel_acceleration > 0:
@@ -283,10 +288,7 @@ class DiffDrive(Part):
         own, not ramped by wheelAcceleration, not stopped by command_timeout), neither of them
         zero (a stopped wheel's hold reads its angle anew at each update). Bullet's motors
         then stay as they are, to the bit, whether the update runs or not."""
-        v, w = self.command
-        if self.command_timeout > 0 and (self._command_time is None or
-                                         sim_time - self._command_time > self.command_timeout):
-            v, w = 0.0, 0.0
+        v, w = self._command_at(sim_time)
         rims = self._rim_speed
         radius = self.wheel_radius
         for rim, speed in zip(rims, self.wheel_speeds(v, w)):

@@ -1,7 +1,7 @@
 """The GUI's viewer process: a pybullet window that shows what the simulator sends on stdin
 (see window.py), and nothing else. Its pybullet server only draws: no physics is stepped.
 
-  python -m pybullet_gazebo.gui.viewer [--fps 30] [--follow true|false]
+  python -m pybullet_gazebo.gui.viewer [--fps 30] [--follow true|false]   (default true)
 
 Messages (pickled, one after another on stdin):
   ("world", WorldSpec)                  the world's models, coloured by their SDF materials
@@ -9,8 +9,10 @@ Messages (pickled, one after another on stdin):
   ("remove", name)
   ("frame", sim_time, real_time_factor, {model: [link frames]}, {robot: (root link frame,
    {joint: position})}, [(origin, beam ends, hit flags)])
-The window: no debug panels; the camera frames the whole world on start; `f` makes it
-follow the first robot (and `f` again stops), keeping the user's angle and distance; the
+The window: no debug panels; the camera frames the whole world on start. With --follow
+true it comes close to the first robot as soon as there is one (ROBOT_VIEW) and follows it,
+keeping whatever angle and distance the user gives it; `f` stops following (and `f` again
+follows, keeping the user's angle and distance). The
 beams of visualized lasers in blue (a return) or grey (none within range); sim time and
 real-time factor at the top. pybullet renders at most `fps` frames per second
 (--minGraphicsUpdateTimeMs, in microseconds despite its name). The viewer ends when stdin
@@ -42,6 +44,7 @@ MISS_COLOUR = (0.6, 0.6, 0.7)
 TEXT_COLOUR = (0.05, 0.05, 0.05)
 LINES_DRAWN = 24                # beam lines per sensor
 PLANE_THICKNESS = 0.01          # [m] the ground is drawn as a thin box just below z 0
+ROBOT_VIEW = (4.0, -45.0)       # [m] distance, [deg] pitch: the camera on a followed robot at first
 
 
 class Viewer:
@@ -54,6 +57,7 @@ class Viewer:
                      pybullet.COV_ENABLE_SEGMENTATION_MARK_PREVIEW, pybullet.COV_ENABLE_SHADOWS):
             self.client.configureDebugVisualizer(flag, 0)
         self.follow = follow
+        self.came_close = False     # the camera came to ROBOT_VIEW of a followed robot once
         self.models = {}            # name -> [(link index, [(body, collision pose)])]
         self.robots = {}            # name -> (body, {joint: index}, base inertial offset)
         self.lines = []             # debug line ids, reused from frame to frame
@@ -202,6 +206,9 @@ class Viewer:
         camera = client.getDebugVisualizerCamera()
         yaw, pitch, distance, target = camera[8], camera[9], camera[10], camera[11]
         if self.follow and followed is not None:
+            if not self.came_close:
+                distance, pitch = ROBOT_VIEW
+                self.came_close = True
             target = (followed[0], followed[1], 0.0)
             client.resetDebugVisualizerCamera(distance, yaw, pitch, target)
         text = "sim time %.1f s   real time factor %.2f" % (sim_time, rtf)
@@ -249,7 +256,7 @@ class Viewer:
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--fps", type=float, default=30.0)
-    parser.add_argument("--follow", default="false")
+    parser.add_argument("--follow", default="true")
     args = parser.parse_args(argv)
     viewer = Viewer(args.fps, args.follow.lower() in ("true", "1"))
     source = sys.stdin.buffer

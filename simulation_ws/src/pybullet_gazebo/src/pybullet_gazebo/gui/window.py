@@ -34,10 +34,11 @@ MAX_BEAMS_SENT = 240          # beams per visualized sensor (every k-th of the s
 VIEWER = [sys.executable, "-m", "pybullet_gazebo.gui.viewer"]
 
 
-def open_window(world, fps=30.0, rays="sdf", follow=False, info=print, warn=print):
+def open_window(world, fps=30.0, rays="sdf", follow=True, info=print, warn=print):
     """A GuiWindow on $DISPLAY, or None (with a warning saying why) when no window can be
     opened. `rays`: "sdf" draws the beams of sensors whose <visualize> is true (Gazebo's
-    rule), "true" of every ray sensor, "false" of none."""
+    rule), "true" of every ray sensor, "false" of none. `follow`: the camera comes close to
+    the first robot and follows it (else it stays on the whole world)."""
     problem = display_problem()
     if problem is not None:
         warn("gui requested but %s: running headless; pass gui:=false to silence this" % problem)

@@ -21,7 +21,8 @@ parameters (~name), with units:
   gui_fps             [Hz wall] at most this many frames per second in that window
   gui_rays            laser beams drawn: sdf (as the sensor's <visualize>, Gazebo's rule),
                       true (every ray sensor) or false
-  gui_follow          the window's camera follows the robot from the start (key f toggles)
+  gui_follow          the window's camera comes close to the robot and follows it (key f
+                      toggles); false: it frames the whole world
   debug               log at debug level
   legacy_mode         true: diff drives as Kinetic's with <legacyMode>true whatever the URDF
                       says (m2wr turns counter-clockwise for a positive angular.z, as the
@@ -57,7 +58,7 @@ class SimulatorParams:
     gui: bool = False
     gui_fps: float = 30.0                   # [Hz] wall
     gui_rays: str = "sdf"                   # sdf | true | false
-    gui_follow: bool = False
+    gui_follow: bool = True
     debug: bool = False
     legacy_mode: bool = False
     contacts: bool = False
