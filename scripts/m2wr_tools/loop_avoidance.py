@@ -11,11 +11,11 @@ import rospy
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import LaserScan
 
-from .tutorial import load_tutorial_program
+from . import tutorial_scripts
 
 
 def main():
-    tutorial = load_tutorial_program("obstacle_avoidance.py")
+    tutorial = tutorial_scripts.load("obstacle_avoidance.py")
     rospy.init_node("reading_laser")
     rate = rospy.Rate(rospy.get_param("~rate", 20.0))
     tutorial.pub = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
