@@ -301,7 +301,7 @@ def main(argv=None):
                "world": WORLD, "start": dict(zip(("x", "y", "yaw"), START)), "loop": {}}
     status = 0
     try:
-        if not args.listeners_only:
+        if not (args.listeners_only or args.loop_program_only):
             say("engine alone (no ROS)")
             figures["engine"] = engine_figures()
             say("  stepSimulation %.1fx, World.step %.1fx real time, scan %.3f ms" % (
