@@ -22,7 +22,8 @@ plugin's <robotNamespace> or the spawn's namespace; the laser's frame prefixed b
 none, by the namespace itself (read once, when the robot is bound).
 """
 import math
-from dataclasses import dataclass
+from collections import Counter
+from dataclasses import dataclass, field
 from typing import Callable, Dict, List
 
 import rospy
@@ -45,6 +46,7 @@ class BindingContext:
     tf_publisher: Callable[[], DirectPublisher]   # the node's /tf publisher, made on first use
     debug: bool = False
     watch_rate: float = 0.0                       # [Hz wall] ~watch_rate (watch_rate.py)
+    commands_by_node: Counter = field(default_factory=Counter)   # for the run summary
 
 
 class Binding:
@@ -124,6 +126,7 @@ class DriveBinding(Binding):
 
     def _on_command(self, msg):
         drive = self.part
+        self.context.commands_by_node[msg._connection_header.get("callerid", "?")] += 1
         if not conversions.is_finite_twist(msg):
             rospy.logwarn_throttle(5.0, "ignored a %s command for '%s' with NaN or inf: %s"
                                    % (drive.command_topic, self.robot.name,

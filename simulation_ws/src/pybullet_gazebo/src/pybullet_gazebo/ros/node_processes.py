@@ -66,6 +66,10 @@ class NodeProcesses:
         self._unknown.clear()
         self.remote.clear()
 
+    def names_of(self, pid):
+        """The node names found for process `pid`."""
+        return sorted(n for n, p in self._pids.items() if p == pid)
+
     def pid_of(self, name):
         """The process id found for node `name`, or "not found"."""
         return self._pids.get(name, "on another machine" if name in self.remote else "unknown")

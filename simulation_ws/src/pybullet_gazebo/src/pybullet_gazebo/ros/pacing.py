@@ -59,6 +59,7 @@ class LockstepStats:
         self.timeouts = 0           # waits that ended with someone still at work
         self.wall_waiting = 0.0     # [s] wall spent in those waits
         self.stepped_past = {}      # who was still at work at a timeout -> times
+        self.waited_for = {}        # who was at work when a wait began -> [s] wall waited
 
     def summary(self):
         text = ("%d waits for the controllers (of %d settles), %.1f s of wall time waiting, "
@@ -66,6 +67,10 @@ class LockstepStats:
         if self.stepped_past:
             text += " (still at work: %s)" % ", ".join(
                 "%s %d x" % item for item in sorted(self.stepped_past.items()))
+        if self.waited_for:
+            text += "; waited for: %s" % ", ".join(
+                "%s %.2f s" % item for item in sorted(self.waited_for.items(),
+                                                       key=lambda item: -item[1])[:5])
         return text
 
 
@@ -110,9 +115,12 @@ class Lockstep:
         if busy is not None:
             started = time.monotonic()
             self.stats.waits += 1
+            first = self.describe(busy)
             busy = self.watch.wait(started + self.timeout,
                                    lambda: self.is_paused() or self.is_shutdown())
-            self.stats.wall_waiting += time.monotonic() - started
+            waited = time.monotonic() - started
+            self.stats.wall_waiting += waited
+            self.stats.waited_for[first] = self.stats.waited_for.get(first, 0.0) + waited
             if busy is not None:
                 if self.is_paused() or self.is_shutdown():
                     return False

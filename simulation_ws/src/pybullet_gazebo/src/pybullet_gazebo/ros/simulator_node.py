@@ -199,6 +199,10 @@ class SimulatorNode:
                       self.world.step_count, self.world.contacts.event_count,
                       "; lockstep: " + self.lockstep.stats.summary()
                       if self.params.lockstep else "")
+        commands = self._binding_context.commands_by_node
+        if commands:
+            rospy.loginfo("run summary: commands received: %s", ", ".join(
+                "%d from %s" % (n, node) for node, n in commands.most_common()))
 
     def _loop(self):
         lockstep = self.lockstep.enabled
@@ -265,12 +269,13 @@ class SimulatorNode:
             or "no controller")
 
     def _describe_busy(self, busy):
+        """A name for what IdleWatch.busy() found at work (for the log and the summary)."""
         pid, _ = busy
         if pid == "self":
             return "the simulator's own reader of a message"
         if pid == "kernel":
             return "the kernel's delivery of packets"
-        names = [n for n, p in self._node_processes._pids.items() if p == pid]
+        names = self._node_processes.names_of(pid)
         return "node %s (pid %d)" % (names[0], pid) if names else "pid %s" % pid
 
     def _steps_ahead(self):
