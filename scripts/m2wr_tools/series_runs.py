@@ -5,7 +5,7 @@ learner would see: reached or not, sim time to the goal, contact events, where i
 
     python -m m2wr_tools.series_runs --program go_to_point --goal -3 7 \\
         [--start 0 8 0] [--world world02] [--modes lockstep real-time] [--repeat 1]
-        [--rate 20] [--duration 60] [--clock-hz 100]
+        [--rate 20] [--duration 60] [--clock-hz 100] [--json PATH]
 
 A run: the world paused (world launch defaults but headless, legacy_mode:=true: the
 series' programs turn as REP 103 says, contacts:=true), m2wr spawned at the start, the
@@ -16,6 +16,7 @@ goal or `duration` of sim time has passed. The same steps in both modes, so that
 difference is the pacing: lockstep (real_time_factor 0) or real time (real_time_factor 1).
 """
 import argparse
+import json
 import math
 import os
 import sys
@@ -232,11 +233,14 @@ def main(argv=None):
     parser.add_argument("--rate", type=float, default=20.0)
     parser.add_argument("--duration", type=float, default=60.0)
     parser.add_argument("--clock-hz", type=float, default=100.0)
-    parser.add_argument("--output", default=os.path.join("output", "series_runs"))
+    parser.add_argument("--output", default=os.path.join("output", "series_runs"),
+                        help="folder for the logs (default output/series_runs)")
+    parser.add_argument("--json", help="also write the runs' records to this file (a list)")
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     if args.program != "follow_wall" and args.goal is None:
         parser.error("--goal X Y is needed for %s" % args.program)
     raise_on_signals()
+    records = []
     try:
         with SeriesSession(os.path.join(args.output, "logs")) as series:
             for mode in args.modes:
@@ -245,7 +249,11 @@ def main(argv=None):
                         args.program, tuple(args.goal) if args.goal else None,
                         tuple(args.start), args.world, mode, args.duration, args.rate,
                         args.clock_hz))
+                    records.append(record)
                     print(describe(record), flush=True)
+                    if args.json:
+                        with open(args.json, "w") as out:
+                            json.dump(records, out, indent=1)
     except SessionError as err:
         sys.stderr.write("series_runs: %s\n" % err)
         return 1

@@ -1,0 +1,79 @@
+"""Lockstep tells the truth for programs written the way the series and its learners write
+them (motion_plan/test/series_style: own rospy.Rate loops, bang-bang turns at 0.7 rad/s to a
+2 deg tolerance, no slow-down): the same start and goal give the same outcome in lockstep as
+at real time (reached or not, contact events), in a time within the spread of real-time runs,
+and two lockstep runs are identical. Each case runs `python -m m2wr_tools.series_runs` (its
+own master, stopped by PID at its end).
+
+Real time varies from run to run: the moment a loop ticks against the drive's updates is left
+to the machine (measured, go to point from (0, 8) to (-6, 6): 13.8, 18.5 and 19.0 s; to
+(-3, 7): 9.4, 10.2 and 11.8 s). Lockstep gives a controller that takes no time, so it lies
+in that spread or a little under it; REAL_TIME_SPREAD is the band allowed around the
+real-time runs of this test."""
+import json
+import subprocess
+import sys
+
+import pytest
+
+REAL_TIME_SPREAD = (0.65, 1.2)      # lockstep time / real-time time: lowest, highest allowed
+GOALS = [(-3.0, 7.0), (6.0, 6.5), (-6.0, 6.0)]     # from (0, 8) in world02
+
+
+def series_runs(tmp_path, program, *args, timeout=900):
+    """The records of `python -m m2wr_tools.series_runs --program PROGRAM ARGS`."""
+    out = tmp_path / "records.json"
+    done = subprocess.run(
+        [sys.executable, "-m", "m2wr_tools.series_runs", "--program", program,
+         "--output", str(tmp_path), "--json", str(out)] + [str(a) for a in args],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout,
+        stdin=subprocess.DEVNULL)
+    assert done.returncode == 0, done.stdout
+    with open(out) as records:
+        return json.load(records)
+
+
+def within_real_time_spread(lockstep, real_times):
+    low, high = REAL_TIME_SPREAD
+    return low * min(real_times) <= lockstep <= high * max(real_times)
+
+
+@pytest.mark.parametrize("goal", GOALS)
+def test_go_to_point_reaches_its_goal_in_lockstep_as_at_real_time(tmp_path, goal):
+    lockstep, *real = series_runs(tmp_path, "go_to_point", "--goal", *goal,
+                                  "--modes", "lockstep", "real-time", "real-time")
+    for record in [lockstep] + real:
+        assert record["reached"], record
+        assert record["contact_events"] == 0, record
+    times = [r["time_to_goal_s"] for r in real]
+    assert within_real_time_spread(lockstep["time_to_goal_s"], times), \
+        (lockstep["time_to_goal_s"], times)
+
+
+@pytest.mark.parametrize("rate", [10, 20, 50])
+def test_two_lockstep_runs_are_identical_at_any_loop_rate(tmp_path, rate):
+    first, second = series_runs(tmp_path, "go_to_point", "--goal", -3, 7, "--rate", rate,
+                                "--modes", "lockstep", "--repeat", 2)
+    assert first["reached"] and second["reached"]
+    assert first["time_to_goal_s"] == second["time_to_goal_s"]
+    assert first["end"] == second["end"]           # the pose at the goal, to the last bit
+
+
+def test_wall_follower_keeps_its_course_in_lockstep_as_at_real_time(tmp_path):
+    runs = series_runs(tmp_path, "follow_wall", "--duration", 40,
+                       "--modes", "lockstep", "real-time")
+    for record in runs:
+        assert record["contact_events"] == 0, record
+        assert record["distance_m"] > 8.0, record           # it went along the walls
+    lockstep, real = (r["distance_m"] for r in runs)
+    assert abs(lockstep - real) <= 0.25 * real, (lockstep, real)
+
+
+def test_bug2_reaches_its_goal_in_lockstep_as_at_real_time(tmp_path):
+    lockstep, real = series_runs(tmp_path, "bug2", "--goal", 0, -4, "--duration", 240,
+                                 "--modes", "lockstep", "real-time")
+    for record in (lockstep, real):
+        assert record["reached"], record
+    assert lockstep["contact_events"] == real["contact_events"], (lockstep, real)
+    assert within_real_time_spread(lockstep["time_to_goal_s"], [real["time_to_goal_s"]]), \
+        (lockstep["time_to_goal_s"], real["time_to_goal_s"])
