@@ -44,6 +44,7 @@ import json
 import math
 import os
 import shlex
+import shutil
 import statistics
 import sys
 import time
@@ -51,7 +52,7 @@ import time
 from . import results
 from .metrics import TASKS, Task
 from .names import DEFAULT_START, DEFAULT_WORLD, TUTORIAL_CONTROLLER
-from .paths import ROOT
+from .paths import ROOT, world_path
 from .rig import RunOptions
 from .scenarios import FREE_MARGIN, check_starts, combinations, grid_starts, random_starts
 
@@ -131,18 +132,49 @@ def parse_args(argv):
     if args.scheduler and not args.scheduler.startswith(("tcp://", "tls://", "inproc://")):
         parser.error("--scheduler must be an address like tcp://127.0.0.1:8786")
     args.world = args.world or [DEFAULT_WORLD]
+    from pybullet_gazebo.engine.sdf_world import WorldFileError
+    for world in args.world:
+        try:
+            world_path(world)
+        except WorldFileError as err:
+            parser.error("--world %s: %s" % (world, err))
+    try:
+        controller_argv(args.controller)
+    except ValueError as err:
+        parser.error(str(err))
     return args
+
+
+CONTROLLER_EXAMPLE = "e.g. --controller \"rosrun motion_plan obstacle_avoidance.py\" or " \
+    "--controller ~/my_controller.py"
 
 
 def controller_argv(text):
     """The controller's command line: a script path runs with this venv's python (if .py)
-    or as it is; anything else is split like a shell would."""
+    or as it is; anything else is split like a shell would. ValueError, naming the input and
+    the fix, for a script that is not there or a command this machine does not have."""
     path = os.path.abspath(os.path.expanduser(text))
     if os.path.isfile(path):
         return (sys.executable, path) if path.endswith(".py") else (path,)
     argv = tuple(shlex.split(text))
     if not argv:
-        raise ValueError("--controller is empty; pass a command line or a script path")
+        raise ValueError("--controller is empty; pass a command line or a script path (%s)"
+                         % CONTROLLER_EXAMPLE)
+    if len(argv) == 1 and ("/" in text or text.endswith(".py")):
+        raise ValueError("--controller %s: no such file; pass the path of an existing script "
+                         "or a command line (%s)" % (text, CONTROLLER_EXAMPLE))
+    if shutil.which(argv[0]) is None:
+        raise ValueError("--controller %r: command %s not found; run 'source scripts/env.sh' "
+                         "first for rosrun/roslaunch, or pass a script path (%s)"
+                         % (text, argv[0], CONTROLLER_EXAMPLE))
+    if argv[0] in ("rosrun", "roslaunch") and len(argv) >= 2 and not argv[1].endswith(".launch"):
+        import rospkg
+        try:
+            rospkg.RosPack().get_path(argv[1])
+        except rospkg.ResourceNotFound:
+            raise ValueError("--controller %r: package %s not found on ROS_PACKAGE_PATH "
+                             "(source your workspace's devel/setup.bash, or pass a script "
+                             "path)" % (text, argv[1])) from None
     return argv
 
 

@@ -27,8 +27,8 @@ def test_a_script_path_runs_with_this_python(tmp_path):
     script = tmp_path / "mine.py"
     script.write_text("print('hi')\n")
     assert evaluate.controller_argv(str(script)) == (sys.executable, str(script))
-    assert evaluate.controller_argv("roslaunch my_pkg my.launch x:=1") == (
-        "roslaunch", "my_pkg", "my.launch", "x:=1")
+    assert evaluate.controller_argv("roslaunch motion_plan my.launch x:=1") == (
+        "roslaunch", "motion_plan", "my.launch", "x:=1")
     with pytest.raises(ValueError, match="--controller is empty"):
         evaluate.controller_argv("  ")
 
@@ -40,6 +40,11 @@ def test_a_script_path_runs_with_this_python(tmp_path):
     (["--task", "goal"], "--task goal needs --goal"),
     (["--scheduler", "localhost:8786"], "--scheduler must be an address like tcp://"),
     (["--task", "dance"], "invalid choice"),
+    (["--world", "world99"], "--world world99: world 'world99' not found"),
+    (["--controller", "/no/such/file.py"], "--controller /no/such/file.py: no such file; pass "
+                                           "the path of an existing script"),
+    (["--controller", "rosrun no_such_package go.py"], "package no_such_package not found"),
+    (["--controller", "rosrunn motion_plan go.py"], "command rosrunn not found"),
 ])
 def test_bad_arguments_are_named(argv, message, capsys):
     with pytest.raises(SystemExit) as exit_info:
