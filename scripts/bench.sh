@@ -8,18 +8,11 @@
 #   scripts/bench.sh --bug [--worlds world02 world03] [--output output/]
 #     the series' bug-2 runs in lockstep (m2wr_tools.bench_bug): x real time, lockstep
 #     time-outs, contact events
-# Prints the figures side by side and writes them to output/bench.json. Needs the project
-# set up (scripts/setup.sh); sources scripts/env.sh itself.
+# Prints the figures side by side and writes them to output/bench.json. Runs
+# scripts/setup.sh first unless the project is already set up, and sources scripts/env.sh.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-if [ ! -f "$ROOT/catkin_ws/devel/setup.bash" ] || [ ! -x "$ROOT/.venv/bin/python" ] \
-   || ! (cd / && "$ROOT/.venv/bin/python" -c "import m2wr_tools" 2>/dev/null); then
-  echo "bench: the project is not set up; run scripts/setup.sh first" >&2
-  exit 1
-fi
-set +u
-source "$ROOT/scripts/env.sh"
-set -u
+source "$ROOT/scripts/ensure_ready.sh" bench
 if [ "${1:-}" = "--bug" ]; then
   shift
   exec python -m m2wr_tools.bench_bug "$@"

@@ -14,14 +14,12 @@ wants_help=false
 for arg in "$@"; do
   case "$arg" in -h|--help) wants_help=true ;; esac
 done
-if [ ! -f "$ROOT/catkin_ws/devel/setup.bash" ]; then
-  if $wants_help; then             # nothing set up yet: this file's header, setting up nothing
-    sed -n '2,/^set /{s/^# \{0,1\}//p}' "${BASH_SOURCE[0]}" | sed '/^set /d'
-    exit 0
-  fi
-  bash "$ROOT/scripts/setup.sh"
+if $wants_help && [ ! -f "$ROOT/catkin_ws/devel/setup.bash" ]; then
+  # nothing set up yet: this file's header, setting up nothing
+  sed -n '2,/^set /{s/^# \{0,1\}//p}' "${BASH_SOURCE[0]}" | sed '/^set /d'
+  exit 0
 fi
-set +u; source "$ROOT/scripts/env.sh"; set -u
+source "$ROOT/scripts/ensure_ready.sh" train
 # --help needs neither torch nor SB3 (train.py imports them only to train)
 if ! $wants_help && ! python -c "import torch, stable_baselines3" 2>/dev/null; then
   echo "[train] installing the training extra (requirements-train.txt: torch CPU, stable-baselines3)"
