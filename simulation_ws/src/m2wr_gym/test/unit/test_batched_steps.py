@@ -4,7 +4,7 @@ step at a time (observations with laser noise, rewards, endings, poses, contacts
 import gymnasium
 import numpy as np
 
-from pybullet_gazebo.engine.world import World
+from pybullet_gazebo.engine.stepping import Stepper
 
 ACTIONS = np.random.default_rng(5).uniform([-0.6, -1.0], [0.6, 1.0], size=(60, 2)).astype(np.float32)
 AHEAD = np.array([0.6, 0.0], dtype=np.float32)          # full speed ahead: into obstacles
@@ -26,6 +26,6 @@ def rollout(seed):
 def test_batched_episodes_equal_step_by_step_ones(monkeypatch):
     batched = [rollout(seed) for seed in (3, 5)]
     assert any(step[-1] for trace in batched for step in trace[1:])    # some touched a model
-    monkeypatch.setattr(World, "_quiet_steps", lambda self, most, now, skipped=None: (1, ()))
+    monkeypatch.setattr(Stepper, "_quiet_steps", lambda self, most, now, skipped=None: (1, ()))
     single = [rollout(seed) for seed in (3, 5)]
     assert batched == single

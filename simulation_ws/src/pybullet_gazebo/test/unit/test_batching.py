@@ -53,13 +53,13 @@ class Calls:
 
     def __init__(self, world):
         self.calls, self.steps = 0, 0
-        step = world._batcher.step
+        step = world.stepper.batcher.step
 
         def counted(step_size, k):
             self.calls += 1
             self.steps += k
             step(step_size, k)
-        world._batcher.step = counted
+        world.stepper.batcher.step = counted
 
 
 def state(world, robot):
@@ -204,12 +204,12 @@ def test_pressed_on_a_barrier_it_steps_one_by_one_and_reads_contacts_after_each(
         counts["hooks"] += 1
         hook(*args)
     world.contacts.update, drive_part.before_step = read, counted_hook
-    guard = world._batcher.safe_time
+    guard = world.stepper.batcher.safe_time
 
     def counted_guard(*args, **kwargs):
         counts["guard"] = counts.get("guard", 0) + 1
         return guard(*args, **kwargs)
-    world._batcher.safe_time = counted_guard
+    world.stepper.batcher.safe_time = counted_guard
     touched = set()
     world.advance(100, touched=touched)
     assert touched and all(other.startswith("jersey_barrier") for _, other in touched)
@@ -305,10 +305,10 @@ def test_safe_time_shrinks_near_an_obstacle(make_world, world02, m2wr_urdf):
     world.spawn_urdf("m2wr", m2wr_urdf, Pose.from_xyz_rpy(0, 8, 0.1))
     world.advance(40)
     robots, others, grounds = world._guarded
-    assert world._batcher.safe_time(robots, others, grounds, 0.1) == 0.1
+    assert world.stepper.batcher.safe_time(robots, others, grounds, 0.1) == 0.1
     world.set_model_state("m2wr", Pose.from_xyz_rpy(0, 5.55, 0.1, 0, 0, -math.pi / 2))
     world.advance(40)
-    assert world._batcher.safe_time(robots, others, grounds, 0.1) < 2 * STEP
+    assert world.stepper.batcher.safe_time(robots, others, grounds, 0.1) < 2 * STEP
 
 
 @pytest.mark.parametrize("collect, calls_per_command", [(True, 3), ((), 1)])
@@ -502,8 +502,8 @@ def test_a_call_that_continues_another_keeps_the_guards_answer_and_stays_identic
         robot = world.spawn_urdf("m2wr", m2wr_urdf, FACING_ROW_A)
         drive_part = next(p for p in robot.parts if isinstance(p, DiffDrive))
         asked = []
-        safe_time = world._batcher.safe_time
-        world._batcher.safe_time = lambda *a, **k: asked.append(1) or safe_time(*a, **k)
+        safe_time = world.stepper.batcher.safe_time
+        world.stepper.batcher.safe_time = lambda *a, **k: asked.append(1) or safe_time(*a, **k)
         trace = []
         for index, command in enumerate(commands):
             touched = set()

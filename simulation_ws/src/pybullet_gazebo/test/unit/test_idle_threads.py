@@ -89,7 +89,8 @@ def test_a_sleeping_process_is_idle(child):
     worker = child(WORKER, "0.01")
     watch = IdleWatch()
     watch.watch([worker.pid])
-    assert watch.busy() is None
+    assert settle(watch) is None                   # once it sleeps in its read, it is idle
+    assert watch.busy() is None and watch.spinners() == {}
 
 
 def test_waits_until_the_child_is_done_with_each_message(child):

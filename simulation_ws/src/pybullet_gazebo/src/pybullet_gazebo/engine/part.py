@@ -2,25 +2,35 @@
 would run as a model plugin or a sensor (a diff drive, a laser, a joint-state publisher...).
 
 A part declares what it does by overriding the hooks below; every hook has a no-op default,
-so the World calls them all and never probes a part for what it can do. Per physics step:
+so the World calls them all and never probes a part for what it can do. Two tiers:
+
+What every part gives (per physics step, and on demand):
 
     before_step(now, dt)   the step that starts at sim time `now` [s] is about to run (dt [s])
     after_step(now)        the step ended; `now` is the new sim time [s]
     due(now) -> bool       a reading is due now; if so the World calls measure(now) at once
     measure(now)           the reading (LaserScanData, Odometry, JointStates, ...): plain data
+    reset()                simulation reset: forget commands, restart timers
+    reseed(rng)            take this numpy Generator for any noise (reset_simulation)
+    next_command_time()    [s] sim time at which the part next reads a command, or None if
+                           it takes none (lockstep settles the controllers before it)
+    positive_turn_direction()  'clockwise' / 'counter-clockwise' for a drive, else None
+
+What a part adds to be skipped or batched (stepping.py; the defaults keep every step single
+and every reading measured, which is always correct, only slower):
+
     skip(now)              instead of measure(now) when nobody reads it (World.step with
                            collect=False): the part's schedule and noise stream advance
                            exactly as if it had measured (default: measure, result dropped)
     next_hook_time(now) -> float   [s] asked after before_step(now): the part promises that
                            before_step and after_step at every sim time t with
                            now < t < the answer do nothing, so the World may run those steps
-                           in one Bullet call (World.advance). The default, `now`, makes it
-                           step one step at a time: a part that does something every step
-                           (integrates, applies forces) keeps it. A hook call that would
-                           change nothing in Bullet may be left out of the promise, if the
-                           part keeps its own schedule as if the call had been made
-                           (after_step(now) ends every stretch; the diff drive's update with
-                           an unchanged command is one).
+                           in one Bullet call. The default, `now`, makes it step one step at
+                           a time: a part that does something every step (integrates,
+                           applies forces) keeps it. A hook call that would change nothing in
+                           Bullet may be left out of the promise, if the part keeps its own
+                           schedule as if the call had been made (after_step(now) ends every
+                           stretch; the diff drive's update with an unchanged command is one).
     next_reading_time(now) -> float   [s] the same promise for due(t): False for every
                            now < t < the answer (default `now`). A reading nobody collects
                            (skip) may then fall inside a stretch: after it, the World calls
@@ -28,14 +38,6 @@ so the World calls them all and never probes a part for what it can do. Per phys
                            answer on, in step order, as single steps would have. So skip must
                            not touch Bullet, and due and skip must not need after_step first.
     next_activity_time(now)  the earlier of the two (not overridden)
-
-and on demand:
-
-    reset()                simulation reset: forget commands, restart timers
-    reseed(rng)            take this numpy Generator for any noise (reset_simulation)
-    next_command_time()    [s] sim time at which the part next reads a command, or None if
-                           it takes none (lockstep waits for a controller's answer until then)
-    positive_turn_direction()  'clockwise' / 'counter-clockwise' for a drive, else None
 
 A part class is built by `build(context, spec)` from the `<gazebo>` tag it stands in for
 (a PluginSpec or a RaySensorSpec), with a PartContext: everything it may need of its robot.
@@ -106,18 +108,6 @@ class Part:
     def measure(self, now: float):
         return None
 
-    def skip(self, now: float) -> None:
-        self.measure(now)
-
-    def next_hook_time(self, now: float) -> float:
-        return now
-
-    def next_reading_time(self, now: float) -> float:
-        return now
-
-    def next_activity_time(self, now: float) -> float:
-        return min(self.next_hook_time(now), self.next_reading_time(now))
-
     def reset(self) -> None:
         pass
 
@@ -129,3 +119,16 @@ class Part:
 
     def positive_turn_direction(self) -> Optional[str]:
         return None
+
+    # --- the scheduling tier (see the module docstring) ----------------------------------
+    def skip(self, now: float) -> None:
+        self.measure(now)
+
+    def next_hook_time(self, now: float) -> float:
+        return now
+
+    def next_reading_time(self, now: float) -> float:
+        return now
+
+    def next_activity_time(self, now: float) -> float:
+        return min(self.next_hook_time(now), self.next_reading_time(now))

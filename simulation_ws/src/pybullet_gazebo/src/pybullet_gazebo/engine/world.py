@@ -1,9 +1,10 @@
 """The simulated world: stepping at a fixed step, the models in it, and what Gazebo's world
 services need (model states, reset, delete, spawn, contacts).
 
-Jobs elsewhere: bodies.py builds world models' bodies, robot_loader.py loads URDF robots and
-their parts, placement.py checks requested poses and overlaps, contacts.py tracks touches,
-batching.py runs quiet stretches of steps in one Bullet call (World.advance).
+Jobs elsewhere: stepping.py advances time (World.advance delegates to its Stepper),
+bodies.py builds world models' bodies, robot_loader.py loads URDF robots and their parts,
+placement.py checks requested poses and overlaps, contacts.py tracks touches, batching.py
+runs quiet stretches of steps in one Bullet call.
 
 Frames: a model's pose is its model frame in the world, as Gazebo reports it. A robot is one
 Bullet multibody whose model frame is its root link's frame. Bullet reports a body's inertial
@@ -18,7 +19,7 @@ import numpy as np
 import pybullet
 
 from . import wheel_contact
-from .batching import MAX_BATCH, Batcher, GuardedRobot, bounding_radius
+from .batching import GuardedRobot, bounding_radius
 from .bodies import build_model
 from .contacts import ContactTracker
 from .entities import Entity, Reading, Robot
@@ -27,6 +28,7 @@ from .raycast import RayCaster
 from .robot_description import parse_robot
 from .robot_loader import SpawnError, load_body, make_robot
 from .sdf_world import load_model_text
+from .stepping import Stepper
 from .specs import WorldSpec
 from .transforms import Pose
 from .wrenches import WrenchSchedule
@@ -69,13 +71,7 @@ class World:
         self._stepped = ([], [])                    # cache: (robot, part) pairs, (name, body)
         self._guarded = ([], [], frozenset())       # cache: GuardedRobots, others, ground bodies
         self._statics = frozenset()                 # cache: bodies of static models
-        self._settled = None        # layout_version after the last step (batches need one)
-        self._single_until = -1     # step count before which advance steps one by one
-        self._safe_until = -1       # step count up to which no contact can start
-        self._read_at = -1          # step count at which the contacts were last read
-        self._guard_end = -1        # step count at which the last advance ended (-1: early)
-        self._horizon_end = 0       # step count up to which the guard looks in this call
-        self._batcher = Batcher(client)
+        self.stepper = Stepper(self, client)        # stepping.py: advance's machinery
         self._grounds = set()                       # names of the ground models
         self.caster = RayCaster(client)
         self.gravity = tuple(spec.physics.gravity)   # [m/s^2]
@@ -152,189 +148,10 @@ class World:
 
     def advance(self, steps, collect=True, touched=None, until_news=False,
                 collect_from=0, continues=False, horizon=None) -> List[Reading]:
-        """`steps` fixed steps, with the same readings (`collect` as for step), contact events,
-        sim time and physics, to the last bit, as `steps` calls of step(); stretches in which
-        nothing can happen between steps (no part's hook acts, no wrench, no contact can
-        start: see batching.py) go to Bullet in one call. `touched`: a set that receives
-        every (robot, other model) pair touching after any of the steps. `until_news`: stop
-        early, after the step that brought readings or changed which robots touch which
-        models (a caller that publishes those at once, as the ROS loop does; step_count says
-        how many steps ran). `collect_from`: the readings due in the steps before this one
-        (0: the first) are skipped whatever `collect` says (a caller that observes only the
-        last of them). A reading that is skipped does not end a stretch (see
-        Part.next_reading_time), except with until_news. `continues`: this call goes on
-        from where the last one ended, with nothing changed in between but parts' commands
-        (a command is read by a part's hook, as within a call), so the contact guard's
-        answers from the last call still hold (otherwise they hold for one call).
-        (A teleport, spawn or delete since makes a fresh start all the same.)
-        `horizon`: how many steps from now the contact guard looks ahead (default `steps`):
-        a caller that will continue with another call asks for both at once."""
-        if self._robots is None:
-            self.robots()                   # refreshes the caches after a spawn or delete
-        parts = self._stepped[0]
-        readings = []
-        left = steps
-        skipped_until = self.step_count + collect_from   # step count after the last skipped
-        if not (continues and self.step_count == self._guard_end
-                and self._settled == self.layout_version):
-            self._safe_until = self._single_until = -1     # the guard's answers: one call
-        self._guard_end = -1                            # (set again if this call ends well)
-        self._horizon_end = self.step_count + (steps if horizon is None else horizon)
-        changes = self.contacts.changes if until_news else None
-        # the readings skipped whatever their time: those of parts not collected, and those
-        # due up to step count skipped_until (None: none is, or readings end stretches)
-        skipping = collect is not True and changes is None
-        inside = ()                     # readings to skip after the next stretch
-        while left > 0:
-            now = self.sim_time
-            for _, part in parts:
-                part.before_step(now, self.step_size)
-            self.wrenches.apply(now)
-            if left > 1:
-                k, inside = self._quiet_steps(
-                    left, now, (collect, skipped_until) if skipping else None)
-            else:
-                k = 1
-            start = self.step_count
-            if k == 1 and self.step_count + 1 < self._single_until:
-                # a quiet stretch the contact guard would not batch: its steps one by one,
-                # contacts read after each, without the parts' hooks (idle until its end)
-                k = self._single_until - self.step_count
-                self._steps_one_by_one(k - 1, touched, changes)
-                if changes is not None and self.contacts.changes != changes:
-                    # a touch began or ended inside the stretch: news, stop at that step
-                    self._settled = self.layout_version
-                    return readings         # (empty: news ends every call at once)
-                self._batcher.step(self.step_size, 1)
-                self.step_count += 1
-            else:
-                self._batcher.step(self.step_size, k)
-                self.step_count += k
-            if k > 1 and inside:
-                self._skip_readings_inside(inside, start, k)
-            left -= k
-            now = self.sim_time
-            for robot, part in parts:
-                part.after_step(now)
-                if part.due(now):
-                    if (collect is True or part in collect) and self.step_count > skipped_until:
-                        readings.append(Reading(robot, part, part.measure(now)))
-                    else:
-                        part.skip(now)
-            self._read_contacts(touched)
-            self._settled = self.layout_version
-            if changes is not None and (readings or self.contacts.changes != changes):
-                break
-        self._guard_end = self.step_count
-        return readings
-
-    def _steps_one_by_one(self, steps, touched, changes=None):
-        """`steps` physics steps, one Bullet call each, the contacts read after each as
-        advance reads them; for the inside of a quiet stretch (no part's hook acts, no
-        wrench), where stepping them one at a time skips nothing but idle hooks. Stops after
-        a step when `changes` (not None) differs from the contacts' change count (which
-        robots touch which models changed)."""
-        step, size = self._batcher.step, self.step_size
-        for _ in range(steps):
-            step(size, 1)
-            self.step_count += 1
-            if self._read_contacts(touched) and changes is not None \
-                    and self.contacts.changes != changes:
-                return
-
-    def _read_contacts(self, touched):
-        """Reads who touches whom after a step, unless the contact guard proved no robot
-        touches a model up to this step; `touched` (a set, or None) receives the pairs.
-        True when read."""
-        if self.step_count <= self._safe_until:
-            return False
-        pairs = self.contacts.update(self.client, self.sim_time, self._stepped[1],
-                                     self._body_owner, self._grounds)
-        self._read_at = self.step_count
-        if touched is not None and pairs:
-            touched.update(pairs)
-        return True
-
-    def _readings_inside(self, skippers, now, steps):
-        """[(part, its next_reading_time)] of the `skippers` whose next reading may fall
-        inside a stretch of `steps` steps from now (at one of its k - 1 inner sim times)."""
-        if steps < 2:
-            return ()
-        last = self.time_after(steps - 1)
-        inside = []
-        for part in skippers:
-            due = part.next_reading_time(now)
-            if due <= last:
-                inside.append((part, due))
-        return inside
-
-    def _skip_readings_inside(self, inside, start, k):
-        """Skips the readings due at the k - 1 sim times inside the stretch of k steps that
-        began at step count `start`, as single steps would have: in step order, and at
-        each time in the parts' order. `inside`: _readings_inside's answer for it."""
-        skippers = [part for part, _ in inside]
-        due_at = [due for _, due in inside]
-        first = min(due_at)
-        for count in range(start + 1, start + k):
-            now = self._time_at(count)
-            if now < first:
-                continue
-            for index, part in enumerate(skippers):
-                if now >= due_at[index] and part.due(now):
-                    part.skip(now)
-                    due_at[index] = part.next_reading_time(now)
-            first = min(due_at)
-
-    def _quiet_steps(self, most, now, skipped=None):
-        """(k, inside): how many of the next `most` steps, the first of which starts now
-        (its before_step hooks done), may run as one Bullet call (see batching.py), and the
-        readings due inside them to be skipped after (see _readings_inside). `skipped`:
-        (collect, skipped_until) as advance has them, when readings nobody collects may fall
-        inside a stretch; None: every reading ends one."""
-        if self.step_count < self._single_until:
-            return 1, ()                    # the contact guard said no for this stretch
-        if self._settled != self.layout_version or not self.wrenches.idle():
-            return 1, ()                    # a teleport, spawn or delete: one step first
-        quiet = math.inf
-        k = min(most, MAX_BATCH)
-        skippers = []
-        if skipped is None:
-            for _, part in self._stepped[0]:
-                quiet = min(quiet, part.next_activity_time(now))
-        else:
-            collect, skipped_until = skipped
-            for _, part in self._stepped[0]:
-                collected = part in collect
-                if collected and self.step_count >= skipped_until:
-                    quiet = min(quiet, part.next_activity_time(now))    # its next is read
-                    continue
-                skippers.append(part)
-                quiet = min(quiet, part.next_hook_time(now))
-                if collected:
-                    # skipped up to step count skipped_until, collected after it: the
-                    # stretch may hold those skipped, and end on the first collected one
-                    k = min(k, skipped_until - self.step_count + 1)
-        # k steps may run when the k - 1 sim times between them come before `quiet`
-        if quiet < math.inf:
-            k = min(k, max(1, int((quiet - now) / self.step_size) + 2))
-        while k > 1 and not self.time_after(k - 1) < quiet:
-            k -= 1
-        k = self._batcher.largest_exact(self.step_size, k)
-        if k > 1 and self.step_count + k > self._safe_until:
-            if self._read_at == self.step_count and self.contacts.any_touching():
-                safe = 0.0                  # a robot touches a model now: no need to ask
-            else:
-                robots, others, grounds = self._guarded
-                horizon = max(most, self._horizon_end - self.step_count)
-                safe = self._batcher.safe_time(robots, others, grounds,
-                                               horizon * self.step_size, self._statics)
-            self._safe_until = self.step_count + int(safe / self.step_size)
-            wanted, k = k, self._batcher.largest_exact(
-                self.step_size, min(k, self._safe_until - self.step_count))
-            if k < 2:
-                self._single_until = self.step_count + wanted
-                return 1, skippers and self._readings_inside(skippers, now, wanted)
-        return k, skippers and self._readings_inside(skippers, now, k)
+        """`steps` fixed physics steps from now; the readings due in them (see
+        stepping.Stepper.advance for every argument)."""
+        return self.stepper.advance(steps, collect, touched, until_news, collect_from,
+                                    continues, horizon)
 
     def next_command_time(self):
         """Earliest sim time [s] at which a part next reads its command (None: no part takes
@@ -355,7 +172,7 @@ class World:
             self._guarded = self._guard_lists()
             self._statics = frozenset(body for e in self.entities.values()
                                       if e.static and not e.is_ground for body in e.body_ids)
-            self._settled = None
+            self.stepper.layout_changed()
         return list(self._robots)
 
     def _guard_lists(self):
