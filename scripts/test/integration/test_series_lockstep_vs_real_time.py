@@ -60,7 +60,8 @@ def test_two_lockstep_runs_are_identical_at_any_loop_rate(tmp_path, rate):
 
 
 def test_wall_follower_keeps_its_course_in_lockstep_as_at_real_time(tmp_path):
-    runs = series_runs(tmp_path, "follow_wall", "--duration", 40,
+    # facing north: from (0, 8) facing east, no wall comes within its 1 m and it circles
+    runs = series_runs(tmp_path, "follow_wall", "--start", 0, 8, 1.5708, "--duration", 40,
                        "--modes", "lockstep", "real-time")
     for record in runs:
         assert record["contact_events"] == 0, record
