@@ -13,6 +13,8 @@ Service: go_to_point_switch (std_srvs/SetBool), inactive at start.
 Parameters:
   des_pos_x, des_pos_y  [m]   the goal, read once, before init_node (as the series does)
   ~rate                 [Hz]  the loop's rate (20)
+  ~active                     start switched on (false: as the series, wait for the switch;
+                              true: for a batch runner that does not call switch services)
   ~turn_sign                  +1: angular.z as written (REP 103, positive = left; the
                               simulator with legacy_mode:=true); -1: negated, for the
                               simulator's default (Gazebo Noetic's diff drive)
@@ -103,10 +105,11 @@ def done():
 
 
 def main():
-    global pub_, turn_sign_
+    global pub_, turn_sign_, active_
     rospy.init_node("go_to_point")
     turn_sign_ = -1.0 if float(rospy.get_param("~turn_sign", 1)) < 0 else 1.0
     rate_hz = float(rospy.get_param("~rate", 20))
+    active_ = bool(rospy.get_param("~active", False))    # the series' starts switched off
     pub_ = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
     rospy.Subscriber("/odom", Odometry, clbk_odom)
     rospy.Service("go_to_point_switch", SetBool, go_to_point_switch)
