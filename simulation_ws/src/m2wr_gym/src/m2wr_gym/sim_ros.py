@@ -8,10 +8,10 @@ m2wr is spawned if it is not in the world (with laser_noise when given).
 Per environment step (exact: each step is dt of sim time and the action reaches the drive at
 the same sim time as in process):
   publish the action on /cmd_vel, /gazebo/unpause_physics, answer every intermediate scan of
-  /m2wr/laser/scan with the same command (lockstep waits for an answer to each scan before the
-  drive's next update), take the scan stamped dt after the last one as the observation, then
-  /gazebo/pause_physics, so the agent may think as long as it likes (lockstep alone would step
-  on after lockstep_timeout).
+  /m2wr/laser/scan with the same command (lockstep waits until this process is done with each
+  scan before the drive's next update), take the scan stamped dt after the last one as the
+  observation, then /gazebo/pause_physics, so the agent may think as long as it likes (an
+  agent that computes for long would otherwise be stepped past after lockstep_timeout).
 Reset: pause, /gazebo/reset_simulation (sim time 0), /gazebo/set_model_state to the start
 pose, unpause, take the first scan (stamped one physics step), pause.
 The pose is /odom's (the drive's odometrySource world: the true pose) stamped with the scan's
