@@ -10,7 +10,8 @@ server that accepts new connections. Each is idle only when it sleeps inside a s
 world's lock with a message in hand.
 
 The threads are found by what rospy runs in them (`threading.Thread._target`); the list is
-made again whenever the number of threads changes.
+made again whenever the set of threads changes (the batch runner's next controller: its
+reader thread replaces the last one's, and their number stays the same).
 """
 import os
 import threading
@@ -31,14 +32,15 @@ def _is_reader(thread):
 
 class OwnReceivers:
     def __init__(self):
-        self._count = -1
+        self._threads = ()
         self._tids = []
 
     def tids(self):
         """The native ids of the reader threads now."""
-        if threading.active_count() != self._count:
-            threads = threading.enumerate()
-            self._count = len(threads)
+        threads = threading.enumerate()
+        if len(threads) != len(self._threads) or \
+                any(a is not b for a, b in zip(threads, self._threads)):
+            self._threads = tuple(threads)
             self._tids = [t.native_id for t in threads if t.native_id and _is_reader(t)]
         return self._tids
 
