@@ -143,10 +143,31 @@ def controller_argv(text):
     argv = tuple(shlex.split(text))
     if not argv:
         raise ValueError("--controller is empty; pass a command line or a script path")
+    if len(argv) == 1 and (os.sep in text or text.endswith(".py")):
+        raise ValueError("--controller %s: no such file; pass the path of an existing "
+                         "script, or a command line such as 'rosrun motion_plan "
+                         "obstacle_avoidance.py'" % text)
     return argv
 
 
+def check_worlds(worlds):
+    """ValueError naming the first world that has no world file, with the known ones."""
+    from pybullet_gazebo.engine.sdf_world import WorldFileError
+    from .paths import world_path
+    for world in worlds:
+        try:
+            world_path(world)
+        except WorldFileError as err:
+            raise ValueError("--world %s: %s" % (world, str(err).replace("world:=NAME",
+                                                                          "--world NAME")))
+
+
 def build_scenarios(args, outlines_of):
+    """The batch's scenarios; ValueError naming a bad world, controller or start."""
+    from .commands import check
+    check_worlds(args.world)
+    controller = controller_argv(args.controller)
+    check(controller, os.environ)
     task = Task(kind=args.task, goal=tuple(args.goal) if args.goal else None,
                 tolerance=args.tolerance, min_distance=args.min_distance)
 
@@ -159,8 +180,7 @@ def build_scenarios(args, outlines_of):
         starts = [tuple(s) for s in args.start] if args.start else [DEFAULT_START]
         check_starts(outlines, starts, margin=args.margin)
         return starts
-    return combinations(args.world, starts_of, args.seeds, args.duration,
-                        controller_argv(args.controller), task)
+    return combinations(args.world, starts_of, args.seeds, args.duration, controller, task)
 
 
 class _Outlines:
