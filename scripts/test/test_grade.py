@@ -195,3 +195,22 @@ def test_the_trajectory_picture_draws_obstacles_path_start_and_goal():
     text = svg(outlines, record, goal=(3.0, 0.0))
     assert text.startswith('<svg xmlns="http://www.w3.org/2000/svg"')
     assert text.count("<circle") == 3 and "<polygon" in text and 'stroke="#080"' in text
+
+
+def test_runs_that_cannot_start_fail_with_their_reason_and_the_rest_are_planned(tmp_path):
+    from m2wr_tools.grade.grading import plan
+    spec = load(_spec(tmp_path, GOOD.replace("    duration: 10\n",
+                                             "    duration: 10\n    world: world99\n")))
+    class_dir = tmp_path / "class"
+    _package(str(class_dir / "ann" / "motion_plan"), scripts=("obstacle_avoidance.py",))
+    (class_dir / "bob").mkdir()
+    todo, failed, shadowed = plan(spec, classroom.discover(str(class_dir)), str(tmp_path / "o"))
+    assert todo == [] and "motion_plan" in shadowed
+    reasons = {(r["student"], r["task"], r["index"]): r["reason"] for r in failed}
+    assert len(reasons) == 2 * (1 + 4)
+    assert reasons[("ann", "avoid", 0)].startswith(
+        "the task's world: world 'world99' not found; set the task's `world:` to one of world01")
+    assert reasons[("ann", "goal", 3)] == ("controller 'roslaunch motion_plan bug2.launch "
+                                           "des_x:=0 des_y:=-4': package 'motion_plan' "
+                                           "(ann/motion_plan) has no launch file 'bug2.launch'")
+    assert reasons[("bob", "goal", 0)].startswith("no package.xml and no scripts")

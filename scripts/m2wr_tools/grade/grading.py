@@ -30,7 +30,7 @@ def _world_problem(world, cache={}):
             cache[world] = None
         except WorldFileError as err:
             cache[world] = "the task's world: %s" % str(err).replace(
-                "pass world:=NAME", "set `world:` in the spec to")
+                "pass world:=NAME with NAME one of", "set the task's `world:` to one of")
     return cache[world]
 
 
