@@ -39,6 +39,8 @@ APT_PACKAGES=(
   # rviz on m2wr (m2wr_description's rviz.launch, launch_world.launch rviz:=true), and its
   # Python bindings, through which the rviz rostest reads the Displays panel (RobotModel OK)
   rviz python3-rviz
+  # the grader's report opened in a real browser by its test (headless, through Playwright)
+  chromium
 )
 
 STEP="check machine"

@@ -70,10 +70,12 @@ def _client(scheduler, workers):
 
 
 def run_batch(scenarios, options: RunOptions, scheduler=None, workers=None, resume=True,
-              progress=True, say=print):
+              progress=True, say=print, task=run_scenario, on_record=None):
     """Runs every scenario not yet in <options.output>/results.json; returns the records of
     the whole batch (earlier ones included), in run-id order. Raises Interrupted on Ctrl-C
-    after cleaning up (the records so far are written)."""
+    after cleaning up (the records so far are written). `task(scenario dict, options dict)`
+    is the Dask task of one run (a tool built on this runner passes its own);
+    `on_record(record, bar)`, if given, is called with each new record as it arrives."""
     from distributed import as_completed
     from tqdm import tqdm
 
@@ -104,7 +106,7 @@ def run_batch(scenarios, options: RunOptions, scheduler=None, workers=None, resu
         client, cluster = _client(scheduler, workers)
         client.register_plugin(_RigTeardown(), name=_RigTeardown.name)
         opts = options_dict(options)
-        futures = [client.submit(run_scenario, s.as_dict(), opts, key="run-%s" % s.run_id,
+        futures = [client.submit(task, s.as_dict(), opts, key="run-%s" % s.run_id,
                                  pure=False) for s in todo]
         pending = set(futures)          # a finished run's result is released at once, so
                                         # that no worker holds every record of the batch
@@ -133,6 +135,8 @@ def run_batch(scenarios, options: RunOptions, scheduler=None, workers=None, resu
             minutes = (time.monotonic() - started) / 60.0
             bar.set_postfix_str("failed %d, %.1f runs/min" % (failures, bar.n / minutes
                                                              if minutes > 0 else 0.0))
+            if on_record is not None:
+                on_record(record, bar)
     except Interrupted:
         raise
     finally:

@@ -44,7 +44,6 @@ import json
 import math
 import os
 import shlex
-import shutil
 import statistics
 import sys
 import time
@@ -52,7 +51,7 @@ import time
 from . import results
 from .metrics import TASKS, Task
 from .names import DEFAULT_START, DEFAULT_WORLD, TUTORIAL_CONTROLLER
-from .paths import ROOT, world_path
+from .paths import ROOT
 from .rig import RunOptions
 from .scenarios import FREE_MARGIN, check_starts, combinations, grid_starts, random_starts
 
@@ -132,53 +131,43 @@ def parse_args(argv):
     if args.scheduler and not args.scheduler.startswith(("tcp://", "tls://", "inproc://")):
         parser.error("--scheduler must be an address like tcp://127.0.0.1:8786")
     args.world = args.world or [DEFAULT_WORLD]
-    from pybullet_gazebo.engine.sdf_world import WorldFileError
-    for world in args.world:
-        try:
-            world_path(world)
-        except WorldFileError as err:
-            parser.error("--world %s: %s" % (world, err))
-    try:
-        controller_argv(args.controller)
-    except ValueError as err:
-        parser.error(str(err))
     return args
-
-
-CONTROLLER_EXAMPLE = "e.g. --controller \"rosrun motion_plan obstacle_avoidance.py\" or " \
-    "--controller ~/my_controller.py"
 
 
 def controller_argv(text):
     """The controller's command line: a script path runs with this venv's python (if .py)
-    or as it is; anything else is split like a shell would. ValueError, naming the input and
-    the fix, for a script that is not there or a command this machine does not have."""
+    or as it is; anything else is split like a shell would."""
     path = os.path.abspath(os.path.expanduser(text))
     if os.path.isfile(path):
         return (sys.executable, path) if path.endswith(".py") else (path,)
     argv = tuple(shlex.split(text))
     if not argv:
-        raise ValueError("--controller is empty; pass a command line or a script path (%s)"
-                         % CONTROLLER_EXAMPLE)
-    if len(argv) == 1 and ("/" in text or text.endswith(".py")):
-        raise ValueError("--controller %s: no such file; pass the path of an existing script "
-                         "or a command line (%s)" % (text, CONTROLLER_EXAMPLE))
-    if shutil.which(argv[0]) is None:
-        raise ValueError("--controller %r: command %s not found; run 'source scripts/env.sh' "
-                         "first for rosrun/roslaunch, or pass a script path (%s)"
-                         % (text, argv[0], CONTROLLER_EXAMPLE))
-    if argv[0] in ("rosrun", "roslaunch") and len(argv) >= 2 and not argv[1].endswith(".launch"):
-        import rospkg
-        try:
-            rospkg.RosPack().get_path(argv[1])
-        except rospkg.ResourceNotFound:
-            raise ValueError("--controller %r: package %s not found on ROS_PACKAGE_PATH "
-                             "(source your workspace's devel/setup.bash, or pass a script "
-                             "path)" % (text, argv[1])) from None
+        raise ValueError("--controller is empty; pass a command line or a script path")
+    if len(argv) == 1 and (os.sep in text or text.endswith(".py")):
+        raise ValueError("--controller %s: no such file; pass the path of an existing "
+                         "script, or a command line such as 'rosrun motion_plan "
+                         "obstacle_avoidance.py'" % text)
     return argv
 
 
+def check_worlds(worlds):
+    """ValueError naming the first world that has no world file, with the known ones."""
+    from pybullet_gazebo.engine.sdf_world import WorldFileError
+    from .paths import world_path
+    for world in worlds:
+        try:
+            world_path(world)
+        except WorldFileError as err:
+            raise ValueError("--world %s: %s" % (world, str(err).replace("world:=NAME",
+                                                                          "--world NAME")))
+
+
 def build_scenarios(args, outlines_of):
+    """The batch's scenarios; ValueError naming a bad world, controller or start."""
+    from .commands import check
+    check_worlds(args.world)
+    controller = controller_argv(args.controller)
+    check(controller, os.environ)
     task = Task(kind=args.task, goal=tuple(args.goal) if args.goal else None,
                 tolerance=args.tolerance, min_distance=args.min_distance)
 
@@ -191,8 +180,7 @@ def build_scenarios(args, outlines_of):
         starts = [tuple(s) for s in args.start] if args.start else [DEFAULT_START]
         check_starts(outlines, starts, margin=args.margin)
         return starts
-    return combinations(args.world, starts_of, args.seeds, args.duration,
-                        controller_argv(args.controller), task)
+    return combinations(args.world, starts_of, args.seeds, args.duration, controller, task)
 
 
 class _Outlines:

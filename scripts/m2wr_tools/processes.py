@@ -28,18 +28,22 @@ def port_in_use(port, host="127.0.0.1"):
 
 
 class Child:
-    """A command started in a new session (its own process group), output to a log file."""
+    """A command started in a new session (its own process group), output to a log file;
+    with `user` and `group` (ids; needs root) as that user with no supplementary groups, in
+    `cwd` when given."""
 
-    def __init__(self, name, argv, env, log_path, pass_fds=()):
+    def __init__(self, name, argv, env, log_path, pass_fds=(), user=None, group=None, cwd=None):
         self.name = name
         self.argv = list(argv)
         self.log_path = log_path
         os.makedirs(os.path.dirname(os.path.abspath(log_path)), exist_ok=True)
         self._log = open(log_path, "wb")
+        as_user = {} if user is None else dict(user=user, group=group, extra_groups=[])
         try:
             self.popen = subprocess.Popen(self.argv, env=env, stdout=self._log,
                                           stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                          start_new_session=True, pass_fds=tuple(pass_fds))
+                                          start_new_session=True, pass_fds=tuple(pass_fds),
+                                          cwd=cwd, **as_user)
         except OSError as err:
             self._log.close()
             raise RuntimeError("cannot start %s (%s): %s" % (name, " ".join(self.argv), err))

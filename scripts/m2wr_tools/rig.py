@@ -85,6 +85,8 @@ class RunOptions:
     picture: bool = False             # the demo's picture per run: runs/<run_id>.png
     batch: str = ""                   # the batch's tag (BATCH_TAG in every child's environment)
     warm_start: bool = True           # fork Python controllers from a warm zygote (m2wr_tools.zygote)
+    gui: bool = False                 # the simulator's window (replays); headless by default
+    real_time_factor: float = 0.0     # sim s per wall s; 0 = as fast as the machine allows
 
 
 class RunFailed(Exception):
@@ -163,7 +165,8 @@ class Rig:
         self.session.stop(["controller", "rosbag", "spawn", "world"])
         self.services.close()
         self.key = None
-        self.session.launch_world(scenario.world, real_time_factor=0.0, lockstep=options.lockstep,
+        self.session.launch_world(scenario.world, real_time_factor=options.real_time_factor,
+                                  gui=options.gui, lockstep=options.lockstep,
                                   seed=scenario.seed, paused=True,
                                   pub_clock_frequency=options.clock_hz,
                                   lockstep_timeout=options.lockstep_timeout)
@@ -580,12 +583,18 @@ _LOCK = threading.Lock()          # one run at a time per worker process (one ma
 def run_scenario(scenario, options):
     """Dask task: runs `scenario` (Scenario.as_dict()) with `options` (RunOptions as a dict)
     on this process's rig; returns the record."""
+    return run_on(Rig, Scenario.from_dict(scenario), RunOptions(**options))
+
+
+def run_on(rig_class, scenario, options):
+    """Runs `scenario` on this process's rig, made as `rig_class()` on first use (a tool
+    built on the batch runner passes its Rig subclass); returns the record."""
     global _RIG
     with _LOCK:
         if _RIG is None:
-            _RIG = Rig()
+            _RIG = rig_class()
             atexit.register(close_rig)
-        return _RIG.run(Scenario.from_dict(scenario), RunOptions(**options))
+        return _RIG.run(scenario, options)
 
 
 def close_rig():

@@ -27,8 +27,8 @@ def test_a_script_path_runs_with_this_python(tmp_path):
     script = tmp_path / "mine.py"
     script.write_text("print('hi')\n")
     assert evaluate.controller_argv(str(script)) == (sys.executable, str(script))
-    assert evaluate.controller_argv("roslaunch motion_plan my.launch x:=1") == (
-        "roslaunch", "motion_plan", "my.launch", "x:=1")
+    assert evaluate.controller_argv("roslaunch my_pkg my.launch x:=1") == (
+        "roslaunch", "my_pkg", "my.launch", "x:=1")
     with pytest.raises(ValueError, match="--controller is empty"):
         evaluate.controller_argv("  ")
 
@@ -40,11 +40,6 @@ def test_a_script_path_runs_with_this_python(tmp_path):
     (["--task", "goal"], "--task goal needs --goal"),
     (["--scheduler", "localhost:8786"], "--scheduler must be an address like tcp://"),
     (["--task", "dance"], "invalid choice"),
-    (["--world", "world99"], "--world world99: world 'world99' not found"),
-    (["--controller", "/no/such/file.py"], "--controller /no/such/file.py: no such file; pass "
-                                           "the path of an existing script"),
-    (["--controller", "rosrun no_such_package go.py"], "package no_such_package not found"),
-    (["--controller", "rosrunn motion_plan go.py"], "command rosrunn not found"),
 ])
 def test_bad_arguments_are_named(argv, message, capsys):
     with pytest.raises(SystemExit) as exit_info:
@@ -76,3 +71,36 @@ def test_the_memory_table_reports_rss_at_the_marks_and_its_slope():
     assert "+5.00 MiB per 100 runs" in lines[1]
     short = evaluate.memory_table(runs[:30])
     assert short["marks"] == [1, 30]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--world", "world99"], "--world world99: world 'world99' not found; pass --world NAME "
+                             "with NAME one of world01, world02, world03"),
+    (["--controller", "/no/such/file.py"], "--controller /no/such/file.py: no such file; "
+                                           "pass the path of an existing script"),
+    (["--controller", "rosrun motion_plan nope.py"], "has no file 'nope.py'"),
+    (["--controller", "rosrun no_such_pkg x.py"], "package 'no_such_pkg' not found on "
+                                                  "ROS_PACKAGE_PATH"),
+    (["--controller", "roslaunch motion_plan no.launch"], "has no launch file 'no.launch'"),
+    (["--controller", "no_such_program --flag"], "no program 'no_such_program' on PATH"),
+])
+def test_a_bad_world_or_controller_stops_before_any_run_with_its_name(argv, message, capsys,
+                                                                      tmp_path):
+    status = evaluate.main(argv + ["--output", str(tmp_path), "--no-progress"])
+    err = capsys.readouterr().err
+    assert status == 2 and message in err and "Traceback" not in err
+    assert not (tmp_path / "results.json").exists()
+
+
+def test_a_script_that_is_not_executable_is_named_with_the_fix(tmp_path):
+    from m2wr_tools import commands
+    package = tmp_path / "pkg"
+    (package / "scripts").mkdir(parents=True)
+    (package / "package.xml").write_text("<package format='2'><name>pkg</name>"
+                                         "<version>0.0.0</version></package>")
+    (package / "scripts" / "go.py").write_text("print('hi')\n")
+    env = dict(PATH="/usr/bin:/bin", ROS_PACKAGE_PATH=str(tmp_path))
+    with pytest.raises(ValueError, match="go.py is not executable; chmod \\+x it"):
+        commands.check(("rosrun", "pkg", "go.py"), env)
+    (package / "scripts" / "go.py").chmod(0o755)
+    assert commands.check(("rosrun", "pkg", "go.py"), env) is None

@@ -5,6 +5,7 @@ from the World. Each family lives in its own module:
   wrench_services    apply/clear body wrenches and joint efforts
   physics_services   get/set_physics_properties, pause/unpause, resets, dynamic_reconfigure
   spawn_services     spawn_urdf_model, spawn_sdf_model, delete_model
+  call_log           with /gazebo/call_log set, who called which service, at what sim time
 A request the world cannot honour answers `success: false` with a reason naming the input;
 no request, however malformed, stops the simulator (every handler catches and reports).
 
@@ -20,6 +21,7 @@ from typing import List, Protocol
 import rospy
 
 from pybullet_gazebo.engine.world import Robot, World
+from pybullet_gazebo.ros.call_log import log_callers
 from pybullet_gazebo.ros.physics_services import PhysicsServices
 from pybullet_gazebo.ros.property_services import PropertyServices
 from pybullet_gazebo.ros.spawn_services import SpawnServices
@@ -48,3 +50,4 @@ class GazeboServices:
     def __init__(self, sim: Simulation):
         self.families = [StateServices(sim), PropertyServices(sim), WrenchServices(sim),
                          SpawnServices(sim), PhysicsServices(sim)]
+        self.call_log = log_callers([s for f in self.families for s in f.services], sim.stamp)

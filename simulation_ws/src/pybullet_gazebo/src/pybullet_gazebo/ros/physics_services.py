@@ -65,7 +65,7 @@ class PhysicsServices:
     def __init__(self, sim):
         self.sim = sim
         self.physics = Physics(sim)
-        self._services = [
+        self.services = [          # rospy.Service objects (gazebo_services logs their callers)
             rospy.Service("~get_physics_properties", GetPhysicsProperties, self.get_physics),
             rospy.Service("~set_physics_properties", SetPhysicsProperties, self.set_physics),
             rospy.Service("~pause_physics", Empty, self.pause_physics),

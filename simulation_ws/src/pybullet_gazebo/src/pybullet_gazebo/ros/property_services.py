@@ -45,7 +45,7 @@ ODE_ONLY_JOINT_FIELDS = ("erp", "cfm", "stop_erp", "stop_cfm", "fudge_factor", "
 class PropertyServices:
     def __init__(self, sim):
         self.sim = sim
-        self._services = [
+        self.services = [          # rospy.Service objects (gazebo_services logs their callers)
             rospy.Service("~get_world_properties", GetWorldProperties, self.get_world_properties),
             rospy.Service("~get_model_properties", GetModelProperties, self.get_model_properties),
             rospy.Service("~get_link_properties", GetLinkProperties, self.get_link_properties),

@@ -32,7 +32,7 @@ def _root_tag(text):
 class SpawnServices:
     def __init__(self, sim):
         self.sim = sim
-        self._services = [
+        self.services = [          # rospy.Service objects (gazebo_services logs their callers)
             rospy.Service("~spawn_urdf_model", SpawnModel, self.spawn_urdf_model),
             rospy.Service("~spawn_sdf_model", SpawnModel, self.spawn_sdf_model),
             rospy.Service("~delete_model", DeleteModel, self.delete_model),

@@ -28,7 +28,7 @@ class StateServices:
     def __init__(self, sim):
         self.sim = sim
         self._get_model_count = {}          # model -> requests answered (Gazebo's header.seq)
-        self._services = [
+        self.services = [          # rospy.Service objects (gazebo_services logs their callers)
             rospy.Service("~get_model_state", GetModelState, self.get_model_state),
             rospy.Service("~set_model_state", SetModelState, self.set_model_state),
             rospy.Service("~get_link_state", GetLinkState, self.get_link_state),

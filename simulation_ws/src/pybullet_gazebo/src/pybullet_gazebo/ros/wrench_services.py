@@ -38,7 +38,7 @@ def _finite(values, what):
 class WrenchServices:
     def __init__(self, sim):
         self.sim = sim
-        self._services = [
+        self.services = [          # rospy.Service objects (gazebo_services logs their callers)
             rospy.Service("~apply_body_wrench", ApplyBodyWrench, self.apply_body_wrench),
             rospy.Service("~clear_body_wrenches", BodyRequest, self.clear_body_wrenches),
             rospy.Service("~apply_joint_effort", ApplyJointEffort, self.apply_joint_effort),

@@ -1,0 +1,278 @@
+"""One graded run on a Dask worker: the batch runner's rig (m2wr_tools.rig, same lockstep
+run, same metrics) with the student's packages resolved first, the run isolated
+(m2wr_tools.grade.sandbox) and the task's rules enforced (m2wr_tools.grade.rules).
+
+A GradedScenario is a batch Scenario plus who and what: student, task, run index, the folder
+of the student's staged packages (shared by every worker: under the grader's output), the
+permissions of the task. Its run_id is `<student>__<task>__<index>_<digest>`.
+
+What GradeRig adds to a run:
+  before   the packages copied into the run's own folder (sandbox.prepare), the
+           controller's environment made from it (classroom.overlay_env: their packages
+           first, `shadowed` names nowhere else) and its command resolved in it
+  start    the controller through prlimit, as the slot's user, in its own process group;
+           a Watchdog on its memory that also looks at the master's graph (rules)
+  end      every process of the run stopped by PID (the slot user's, or the controller's
+           group); the simulator's call log read from where the run began; findings judged:
+           a rule broken or the memory limit passed fails the run with that reason
+The record gets: student, task, index, findings (each rule finding), user, isolated,
+memory_peak_mib, leftovers (processes that outlived the controller's stop).
+"""
+from dataclasses import asdict, dataclass, fields
+import hashlib
+import json
+import os
+import xmlrpc.client
+from typing import Tuple
+
+from .. import processes
+from ..metrics import Task
+from ..rig import NODE, Rig, RunOptions, run_on
+from ..scenarios import Scenario
+from . import classroom, rules, sandbox
+from .spec import Limits
+
+CALL_LOG_PARAM = "/gazebo/call_log"     # pybullet_gazebo.ros.call_log.PARAM
+SIMULATOR = "/gazebo"
+
+
+@dataclass(frozen=True)
+class GradedScenario(Scenario):
+    student: str = ""
+    task_name: str = ""
+    index: int = 0
+    packages: str = ""                 # folder of the student's staged packages
+    allow: Tuple[str, ...] = ()
+
+    @property
+    def run_id(self):
+        digest = hashlib.sha1(json.dumps(self.as_dict(), sort_keys=True).encode()).hexdigest()
+        return "%s__%s__%d_%s" % (self.student, self.task_name, self.index, digest[:8])
+
+    def as_dict(self):
+        data = super().as_dict()
+        data.update(student=self.student, task_name=self.task_name, index=self.index,
+                    packages=self.packages, allow=list(self.allow))
+        return data
+
+    @classmethod
+    def from_dict(cls, data):
+        base = Scenario.from_dict(data)
+        return cls(**{f.name: getattr(base, f.name) for f in fields(Scenario)},
+                   student=data["student"], task_name=data["task_name"],
+                   index=int(data["index"]), packages=data["packages"],
+                   allow=tuple(data["allow"]))
+
+
+@dataclass
+class GradeOptions(RunOptions):
+    shadowed: Tuple[str, ...] = ()     # package names found only in the student's folder
+    cpu_s: float = Limits.cpu_s
+    memory_mib: float = Limits.memory_mib
+    processes: int = Limits.processes
+    file_mib: float = Limits.file_mib
+
+    @property
+    def limits(self):
+        return Limits(self.cpu_s, self.memory_mib, self.processes, self.file_mib)
+
+
+class GradeRig(Rig):
+    def __init__(self):
+        super().__init__()
+        self.slot = sandbox.Slot()
+        self.current = None            # the run being graded: _Run
+
+    # --- the simulator logs who calls its services ---------------------------------------
+    def _call_log(self):
+        return os.path.join(self.session.log_dir, "gazebo_calls.jsonl")
+
+    def _ensure_simulator(self, scenario, options):
+        # set before each (re)launch: a run may have changed the parameter
+        self.session.master().setParam(NODE, CALL_LOG_PARAM, self._call_log())
+        return super()._ensure_simulator(scenario, options)
+
+    # --- one run --------------------------------------------------------------------------
+    def run(self, scenario, options):
+        folder = sandbox.prepare(self.slot, scenario.student, scenario.packages)
+        self.current = _Run(scenario, options, folder)
+        try:
+            record = super().run(scenario, options)
+        finally:
+            current, self.current = self.current, None
+            current.finish(self)
+            sandbox.remove(folder)
+        record.update(student=scenario.student, task=scenario.task_name, index=scenario.index,
+                      user=self.slot.name, isolated=sandbox.isolating(),
+                      findings=current.findings, memory_peak_mib=current.peak_mib,
+                      memory_over=current.watchdog.seen if current.watchdog else "",
+                      leftovers=current.leftovers)
+        broken = current.watchdog_finding or rules.verdict(current.findings)
+        if broken:
+            record.update(success=False, reason=broken)
+        return record
+
+    def _resolve(self, argv):
+        """`rosrun PKG EXE ARGS` as the executable's path in the student's packages (as
+        rosrun would find it there); anything else as given."""
+        argv = tuple(argv)
+        if self.current is not None and len(argv) >= 3 and argv[0] == "rosrun":
+            from ..commands import find_in_package, package_dir
+            folder = package_dir(argv[1], self.current.env(self))
+            found = find_in_package(folder, argv[2], executable=True) if folder else []
+            if found:
+                return (found[0],) + argv[3:]
+        return argv
+
+    def _start_controller(self, argv, log_path, warm):
+        run = self.current
+        env = run.env(self)
+        run.calls_from = _size(self._call_log())
+        run.master = xmlrpc.client.ServerProxy(self.session.master_uri)
+        child = processes.Child("controller", sandbox.limited(argv, run.options.limits,
+                                                                sandbox.isolating()), env,
+                                log_path, cwd=run.folder,
+                                user=self.slot.uid if sandbox.isolating() else None,
+                                group=self.slot.gid if sandbox.isolating() else None)
+        self.session.children["controller"] = child
+        run.watch(self, child)
+        return child
+
+    def _stop_controller(self, known_exit):
+        if self.current is not None and self.current.watchdog is not None:
+            self.current.watchdog.stop()           # its last look sees the graph as it ends
+        return super()._stop_controller(known_exit)
+
+    def close(self):
+        super().close()
+        self.slot.close()
+
+
+class _Run:
+    """The state of one graded run on the rig."""
+
+    def __init__(self, scenario, options, folder):
+        self.scenario, self.options, self.folder = scenario, options, folder
+        self.findings, self.seen = [], set()
+        self.broken = False             # a finding no rule allows was seen
+        self.watchdog = self.controller = self.master = None
+        self.calls_from = None
+        self.peak_mib = 0.0
+        self.leftovers = ""
+        self._env = None
+
+    @property
+    def watchdog_finding(self):
+        return self.watchdog.finding if self.watchdog is not None else None
+
+    def env(self, rig):
+        if self._env is None:
+            env = classroom.overlay_env(rig.session.env, os.path.join(self.folder, "ws"),
+                                        self.options.shadowed)
+            self._env = sandbox.environment(env, self.folder)
+        return self._env
+
+    def pids(self, rig):
+        if sandbox.isolating():
+            return sandbox.pids_of_user(rig.slot.uid)
+        return sandbox.group_members(self.controller.pid) if self.controller else []
+
+    def kill(self, rig):
+        if sandbox.isolating():
+            return sandbox.kill_user(rig.slot.uid)
+        if self.controller is not None:
+            pids = self.pids(rig)
+            self.controller.signal_group(9)
+            return processes.describe(pids)
+        return ""
+
+    def watch(self, rig, controller):
+        self.controller = controller
+        self.watchdog = sandbox.Watchdog(lambda: self.pids(rig), self.options.memory_mib,
+                                         lambda: self.kill(rig), also=lambda: self.look(rig))
+        self.watchdog.start()
+
+    def look(self, rig):
+        """New findings from the simulator's call log and the master's graph; a finding no
+        rule allows ends the run's processes at once (the run has failed)."""
+        sim_time = (rig.recorder.sim_time if rig.recorder is not None else None) or 0.0
+        calls, self.calls_from = _read_calls(rig._call_log(), self.calls_from)
+        new = rules.service_findings(calls, self.scenario.allow,
+                                     (self.scenario.x, self.scenario.y), ignore=(NODE,))
+        code, _, state = self.master.getSystemState(NODE)
+        if code == 1:
+            for kind, topic, node in rules.graph_findings(state, ignore=(NODE, SIMULATOR)):
+                if (kind, topic, node) not in self.seen:
+                    self.seen.add((kind, topic, node))
+                    new.append(rules.topic_finding(kind, topic, node, sim_time))
+        self.findings += new
+        if not self.broken and rules.verdict(new):
+            self.broken = True
+            self.kill(rig)
+
+    def finish(self, rig):
+        """After the controller's stop: the last look, the rest of the run's processes
+        stopped by PID."""
+        if self.watchdog is not None:
+            self.watchdog.stop()
+            self.peak_mib = round(self.watchdog.peak_mib, 1)
+        self.leftovers = self.kill(rig)
+        if self.master is not None:
+            forget_nodes(self.master, keep=(NODE, SIMULATOR))
+
+
+def forget_nodes(master, keep):
+    """Unregisters from the master every publisher, subscriber and service of the nodes
+    other than `keep`: a run's nodes stopped with SIGKILL (the watchdog, the end by PID)
+    never unregister, and the next run's rules would see their subscriptions."""
+    code, _, (publishers, subscribers, services) = master.getSystemState(NODE)
+    if code != 1:
+        return
+    uris = {}
+
+    def uri(node):
+        if node not in uris:
+            found = master.lookupNode(NODE, node)
+            uris[node] = found[2] if found[0] == 1 else ""
+        return uris[node]
+    for listing, forget in ((publishers, master.unregisterPublisher),
+                            (subscribers, master.unregisterSubscriber)):
+        for topic, nodes in listing:
+            for node in nodes:
+                if node not in keep:
+                    forget(node, topic, uri(node))
+    for service, nodes in services:
+        for node in nodes:
+            if node not in keep:
+                found = master.lookupService(NODE, service)
+                if found[0] == 1:
+                    master.unregisterService(node, service, found[2])
+
+
+def _size(path):
+    try:
+        return os.path.getsize(path)
+    except OSError:
+        return 0
+
+
+def _read_calls(path, offset):
+    """(the entries of the call log after `offset`, the offset after the last whole line)."""
+    try:
+        with open(path, "rb") as log:
+            log.seek(offset)
+            data = log.read()
+    except OSError:
+        return [], offset
+    whole = data[:data.rfind(b"\n") + 1]
+    return [json.loads(line) for line in whole.splitlines() if line.strip()], \
+        offset + len(whole)
+
+
+def grade_run(scenario, options):
+    """Dask task: one graded run (GradedScenario and GradeOptions as dicts); the record."""
+    return run_on(GradeRig, GradedScenario.from_dict(scenario), GradeOptions(**options))
+
+
+def options_dict(options):
+    return asdict(options)

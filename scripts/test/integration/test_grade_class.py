@@ -1,0 +1,111 @@
+"""scripts/grade.sh on the fixture class (scripts/test/fixtures/class, written for this test)
+with a two-task spec (fixtures/grade_spec.yaml: avoid = `roslaunch motion_plan avoid.launch`,
+wander 10 s; goal = `rosrun motion_plan go_to_point.py` to (2, 8) from (0, 8) facing north,
+15 s): each student gets the grade and the reason a teacher would expect, the machine stays
+responsive while the fork-and-allocate student runs, nothing is left running, and grading
+again gives the same grades.csv byte for byte."""
+import csv
+import json
+import os
+import shutil
+import subprocess
+import threading
+import time
+
+from m2wr_tools.grade import sandbox
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+GRADE = os.path.join(ROOT, "scripts", "grade.sh")
+FIXTURES = os.path.join(ROOT, "scripts", "test", "fixtures")
+
+
+def grade(class_dir, output, *extra, timeout=300):
+    result = subprocess.run(["bash", GRADE, str(class_dir), "--spec",
+                             os.path.join(FIXTURES, "grade_spec.yaml"), "--output", str(output),
+                             "--workers", "2", "--no-progress", *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            timeout=timeout)
+    return result.returncode, result.stdout
+
+
+class Responsiveness(threading.Thread):
+    """The longest wall-time gap [s] between 50 ms sleeps of this thread while it runs."""
+
+    def __init__(self):
+        super().__init__(daemon=True)
+        self.worst, self.running = 0.0, True
+
+    def run(self):
+        last = time.monotonic()
+        while self.running:
+            time.sleep(0.05)
+            now = time.monotonic()
+            self.worst = max(self.worst, now - last - 0.05)
+            last = now
+
+
+def test_the_fixture_class_gets_the_grades_a_teacher_expects(tmp_path):
+    class_dir = tmp_path / "class"
+    shutil.copytree(os.path.join(FIXTURES, "class"), class_dir)
+    os.chmod(class_dir, 0o700)
+    watch = Responsiveness()
+    watch.start()
+    status, text = grade(class_dir, tmp_path / "out")
+    watch.running = False
+    assert status == 0, text
+    with open(tmp_path / "out" / "grades.csv", newline="") as source:
+        rows = {r["student"]: r for r in csv.DictReader(source)}
+    assert set(rows) == {"ada", "bert", "cleo", "dan", "eve", "fay", "gus", "hal"}
+
+    def grade_of(student):
+        r = rows[student]
+        return float(r["avoid"]), float(r["goal"]), float(r["total"]), int(r["rank"])
+    # ada: a correct avoider and go-to-point: full points, first
+    assert grade_of("ada") == (10.0, 10.0, 20.0, 1), rows["ada"]
+    # gus: his launch file spawns m2wr again: refused by the simulator, his avoider graded
+    assert grade_of("gus") == (10.0, 0.0, 10.0, 2), rows["gus"]
+    assert "package 'motion_plan'" in rows["gus"]["failures"] and \
+        "has no file 'go_to_point.py'" in rows["gus"]["failures"]
+    failures = {s: rows[s]["failures"] for s in rows}
+    # bert: loose scripts; his go-to-point turns the wrong way and never gets there
+    assert grade_of("bert")[:3] == (0.0, 0.0, 0.0)
+    assert "goal run 0: did not reach the goal (2.00, 8.00) within 0.30 m" in failures["bert"]
+    assert "has no launch file 'avoid.launch'" in failures["bert"]
+    # cleo teleports, dan reads the ground truth: rules, by which node, at what sim time
+    assert "goal run 0: rules: called /gazebo/set_model_state for m2wr at (2.00, 8.00), by " \
+        "/go_to_point, at 0.00 s" in failures["cleo"]
+    assert "goal run 0: rules: subscribed to /gazebo/model_states, by /go_to_point, at " \
+        in failures["dan"]
+    # eve crashes, fay forks and allocates, hal handed in nothing gradable
+    assert "goal run 0: controller exited with status 1 while starting" in failures["eve"]
+    assert "goal run 0: resources: its processes used more than the 400 MiB of memory allowed" \
+        " together" in failures["fay"]
+    assert "no package.xml and no scripts (.py, .launch)" in failures["hal"]
+    for student in ("bert", "cleo", "dan", "eve", "fay", "hal"):
+        assert rows[student]["total"] == "0.00" and rows[student]["rank"] == "3"
+    data = json.loads((tmp_path / "out" / "results.json").read_text())
+    gus = data["students"]["gus"]["runs"][0]
+    assert [f["allowed"] for f in gus["findings"]] == [True] and \
+        "spawn_urdf_model for m2wr" in gus["findings"][0]["what"]
+    fay = next(r for r in data["students"]["fay"]["runs"] if r["task"] == "goal")
+    if sandbox.isolating():
+        # runs start as the slot's unprivileged user, and the output is the grader's alone
+        assert fay["user"].startswith("m2wr-grade") and fay["isolated"]
+        assert os.stat(tmp_path / "out").st_mode & 0o077 == 0
+    assert watch.worst < 2.0, "the machine stalled %.1f s while grading" % watch.worst
+    # nothing left running: no process of the run users, no process of the batch
+    if sandbox.isolating():
+        for slot in range(2):
+            try:
+                uid = int(subprocess.run(["id", "-u", sandbox.USER % slot], text=True,
+                                         stdout=subprocess.PIPE).stdout)
+            except ValueError:
+                continue
+            assert sandbox.pids_of_user(uid) == []
+    leftover = subprocess.run(["pgrep", "-f", str(tmp_path)], stdout=subprocess.PIPE, text=True)
+    assert leftover.stdout == "", leftover.stdout
+    # grading again from scratch: the same gradebook, byte for byte
+    status, text = grade(class_dir, tmp_path / "again")
+    assert status == 0, text
+    assert (tmp_path / "out" / "grades.csv").read_bytes() == \
+        (tmp_path / "again" / "grades.csv").read_bytes()

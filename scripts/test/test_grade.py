@@ -1,0 +1,216 @@
+"""The grader's parts without a simulator: the spec (errors name the line and the field),
+the class folder (packages, loose scripts, nothing), the overlay that hides the project's
+motion_plan, the rules, the scores and the trajectory picture."""
+import os
+import textwrap
+
+import pytest
+
+from m2wr_tools.commands import check
+from m2wr_tools.grade import classroom, rules, scoring
+from m2wr_tools.grade.report import svg
+from m2wr_tools.grade.spec import DEFAULT_SPEC, SpecError, load
+
+GOOD = """\
+version: 1
+tasks:
+  - name: avoid
+    command: rosrun motion_plan obstacle_avoidance.py
+    kind: wander
+    duration: 10
+  - name: goal
+    command: roslaunch motion_plan bug2.launch des_x:=0 des_y:=-4
+    kind: goal
+    goal: [0, -4]
+    starts: [[0, 8, 0], [1, 8, 0]]
+    seeds: [0, 1]
+    allow: [set_model_state_to_start]
+"""
+
+
+def _spec(tmp_path, text):
+    path = tmp_path / "spec.yaml"
+    path.write_text(textwrap.dedent(text))
+    return str(path)
+
+
+def test_a_spec_gives_its_tasks_and_their_runs(tmp_path):
+    spec = load(_spec(tmp_path, GOOD))
+    avoid, goal = spec.tasks
+    assert avoid.command == ("rosrun", "motion_plan", "obstacle_avoidance.py")
+    assert avoid.starts == ((0.0, 8.0, 0.0),) and avoid.duration == 10.0
+    assert goal.goal == (0.0, -4.0) and goal.allow == ("set_model_state_to_start",)
+    assert [(i, s, seed) for i, s, seed in goal.runs] == [
+        (0, (0.0, 8.0, 0.0), 0), (1, (1.0, 8.0, 0.0), 0), (2, (0.0, 8.0, 0.0), 1),
+        (3, (1.0, 8.0, 0.0), 1)]
+    assert spec.points == 20.0
+
+
+def test_the_default_spec_covers_episodes_5_to_10():
+    spec = load(DEFAULT_SPEC)
+    assert [t.episode for t in spec.tasks] == [5, 6, 7, 8, 9, 10]
+    assert spec.points == 100.0
+    assert all("set_model_state_to_start" in t.allow for t in spec.tasks if "bug" in t.name)
+
+
+@pytest.mark.parametrize("change, message", [
+    (("kind: wander", "kind: dance"), "line 5: tasks[1].kind: 'dance' is not a task kind; "
+                                      "use one of wander, goal, wall"),
+    (("    goal: [0, -4]\n", ""), "line 7: tasks[2]: the goal task 'goal' needs `goal: [x, y]`"),
+    (("duration: 10", "duration: -1"), "line 6: tasks[1].duration: -1 must be a number > 0"),
+    (("starts: [[0, 8, 0], [1, 8, 0]]", "starts: [[0, 8]]"),
+     "line 11: tasks[2].starts: must be a list of [x, y, yaw]"),
+    (("allow: [set_model_state_to_start]", "allow: [teleport]"),
+     "line 13: tasks[2].allow: ['teleport'] must be a list of permissions from: "
+     "set_model_state_to_start"),
+    (("name: goal", "name: avoid"), "line 7: tasks[2].name: 'avoid' is used twice"),
+    (("    kind: wander\n", "    kidn: wander\n"), "line 5: tasks[1].kidn: unknown field"),
+    (("command: rosrun motion_plan obstacle_avoidance.py", "command: python3 x.py"),
+     "line 4: tasks[1].command: 'python3 x.py' must start with rosrun or roslaunch"),
+    (("version: 1", "version: 1\n  oops: [\n"), "line 2: not valid YAML"),
+])
+def test_a_bad_spec_names_the_line_and_the_field(tmp_path, change, message):
+    path = _spec(tmp_path, GOOD.replace(*change))
+    with pytest.raises(SpecError) as error:
+        load(path)
+    assert str(error.value).startswith("spec %s " % path) and message in str(error.value)
+
+
+def test_a_missing_spec_says_where_the_default_is(tmp_path):
+    with pytest.raises(SpecError, match="spec .*nope.yaml not found; pass --spec PATH"):
+        load(str(tmp_path / "nope.yaml"))
+
+
+def _package(folder, name="motion_plan", scripts=("go_to_point.py",)):
+    os.makedirs(os.path.join(folder, "scripts"))
+    with open(os.path.join(folder, "package.xml"), "w") as out:
+        out.write("<package format='2'><name>%s</name><version>0.0.0</version></package>" % name)
+    for script in scripts:
+        with open(os.path.join(folder, "scripts", script), "w") as out:
+            out.write("print('hi')\n")
+
+
+def test_a_class_folder_has_packages_loose_scripts_and_nothing(tmp_path):
+    _package(str(tmp_path / "ann" / "catkin_ws" / "src" / "motion_plan"))
+    (tmp_path / "bob").mkdir()
+    (tmp_path / "bob" / "go_to_point.py").write_text("print('hi')\n")
+    (tmp_path / "cy").mkdir()
+    (tmp_path / "cy" / "notes.txt").write_text("nothing\n")
+    ann, bob, cy = classroom.discover(str(tmp_path))
+    assert (ann.student, ann.kind, [n for n, _ in ann.packages]) == ("ann", "package",
+                                                                      ["motion_plan"])
+    assert (bob.kind, cy.kind) == ("scripts", "nothing")
+    assert "no package.xml and no scripts (.py, .launch)" in cy.problem
+    assert classroom.stage(bob, str(tmp_path / "stage")) == ["motion_plan"]
+    staged = tmp_path / "stage" / "motion_plan" / "scripts" / "go_to_point.py"
+    assert staged.exists() and os.access(staged, os.X_OK)
+
+
+def test_an_empty_or_missing_class_folder_is_named(tmp_path):
+    with pytest.raises(ValueError, match="has no student folders; put one folder per student"):
+        classroom.discover(str(tmp_path))
+    with pytest.raises(ValueError, match="class folder .*nope not found"):
+        classroom.discover(str(tmp_path / "nope"))
+
+
+def test_the_overlay_finds_the_students_package_never_the_projects(tmp_path):
+    project = tmp_path / "project_src"
+    _package(str(project / "motion_plan"), scripts=("obstacle_avoidance.py",))
+    _package(str(project / "my_worlds"), name="my_worlds", scripts=())
+    student = tmp_path / "student"
+    _package(str(student / "motion_plan"), scripts=("go_to_point.py",))
+    for script in (project / "motion_plan" / "scripts").iterdir():
+        script.chmod(0o755)
+    env = {"PATH": os.environ["PATH"], "ROS_PACKAGE_PATH": str(project),
+           "CMAKE_PREFIX_PATH": ""}
+    assert check(("rosrun", "motion_plan", "obstacle_avoidance.py"), env) is None
+    overlay = classroom.overlay_env(env, str(student), ["motion_plan"])
+    assert overlay["ROS_PACKAGE_PATH"].split(":") == [str(student),
+                                                       str(project / "my_worlds")]
+    with pytest.raises(ValueError, match=r"\(%s\) has no file 'obstacle_avoidance.py'"
+                       % (student / "motion_plan")):
+        check(("rosrun", "motion_plan", "obstacle_avoidance.py"), overlay)
+
+
+def test_rules_allow_the_bug_programs_start_and_fail_everything_else():
+    start = (0.0, 8.0, 0.0)
+    to_start = {"service": "/gazebo/set_model_state", "caller": "/bug2", "sim_time": 0.0,
+                "model": "m2wr", "x": 0.0, "y": 8.0}
+    to_goal = dict(to_start, x=0.0, y=-4.0, sim_time=12.5)
+    spawn = {"service": "/gazebo/spawn_urdf_model", "caller": "/spawn", "sim_time": 0.0,
+             "model": "m2wr", "x": 0.0, "y": 8.0}
+    ours = dict(to_start, caller="/m2wr_batch")
+    allowed = rules.service_findings([to_start, spawn, ours], ("set_model_state_to_start",),
+                                     start, ignore=("/m2wr_batch",))
+    assert [f["allowed"] for f in allowed] == [True, True] and rules.verdict(allowed) is None
+    found = rules.service_findings([to_start, to_goal], (), start)
+    assert rules.verdict(found) == ("rules: called /gazebo/set_model_state for m2wr at "
+                                    "(0.00, 8.00), by /bug2, at 0.00 s (and 1 more)")
+    found = rules.service_findings([to_goal], ("set_model_state_to_start",), start)
+    assert rules.verdict(found) == ("rules: called /gazebo/set_model_state for m2wr at "
+                                    "(0.00, -4.00), by /bug2, at 12.50 s")
+    state = ([["/gazebo/set_model_state", ["/cheat"]], ["/cmd_vel", ["/bug2"]]],
+             [["/gazebo/model_states", ["/peek", "/m2wr_batch"]], ["/odom", ["/bug2"]]], [])
+    assert rules.graph_findings(state, ignore=("/m2wr_batch", "/gazebo")) == {
+        ("published on", "/gazebo/set_model_state", "/cheat"),
+        ("subscribed to", "/gazebo/model_states", "/peek")}
+
+
+class _Sub:
+    problem = None
+
+
+def test_scores_ranks_and_the_gradebook_are_stable(tmp_path):
+    spec = load(_spec(tmp_path, GOOD))
+    ok = {"success": True}
+
+    def failed(reason):
+        return {"success": False, "reason": reason}
+    graded = {
+        "zoe": {"submission": _Sub(), "records": [dict(ok, task="avoid", index=0)] + [
+            dict(ok, task="goal", index=i) for i in range(3)] + [
+            dict(failed("controller exited with status 1 while starting; see /x/y.log:\n"
+                        "Traceback"), task="goal", index=3)]},
+        "amy": {"submission": _Sub(), "records": [dict(ok, task="avoid", index=0)] + [
+            dict(failed("rules: called /gazebo/get_model_state, by /a, at 1.00 s"),
+                 task="goal", index=i) for i in range(4)]},
+        "bo": {"submission": _Sub(), "records": [dict(ok, task="avoid", index=0)] + [
+            dict(failed("x"), task="goal", index=i) for i in range(4)]},
+    }
+    rows = scoring.rows(spec, graded)
+    assert [(r["student"], r["total"], r["rank"]) for r in rows] == [
+        ("amy", 10.0, 2), ("bo", 10.0, 2), ("zoe", 17.5, 1)]
+    text = scoring.csv_text(spec, graded)
+    assert text.splitlines()[0] == "student,avoid,goal,total,max,rank,failures"
+    assert text.splitlines()[3] == ("zoe,10.00,7.50,17.50,20.00,1,goal run 3: controller "
+                                    "exited with status 1 while starting")
+    assert text == scoring.csv_text(spec, dict(reversed(list(graded.items()))))
+
+
+def test_the_trajectory_picture_draws_obstacles_path_start_and_goal():
+    from m2wr_tools.scene import Outline
+    outlines = [Outline(model="can", kind="circle", center=(1.0, 1.0), radius=0.5),
+                Outline(model="box", kind="polygon", points=((2, 2), (3, 2), (3, 3), (2, 3)))]
+    record = {"x": 0.0, "y": 0.0, "success": True, "path": [[0, 0, 0], [1, 0.0, 0.5]]}
+    text = svg(outlines, record, goal=(3.0, 0.0))
+    assert text.startswith('<svg xmlns="http://www.w3.org/2000/svg"')
+    assert text.count("<circle") == 3 and "<polygon" in text and 'stroke="#080"' in text
+
+
+def test_runs_that_cannot_start_fail_with_their_reason_and_the_rest_are_planned(tmp_path):
+    from m2wr_tools.grade.grading import plan
+    spec = load(_spec(tmp_path, GOOD.replace("    duration: 10\n",
+                                             "    duration: 10\n    world: world99\n")))
+    class_dir = tmp_path / "class"
+    _package(str(class_dir / "ann" / "motion_plan"), scripts=("obstacle_avoidance.py",))
+    (class_dir / "bob").mkdir()
+    todo, failed, shadowed = plan(spec, classroom.discover(str(class_dir)), str(tmp_path / "o"))
+    assert todo == [] and "motion_plan" in shadowed
+    reasons = {(r["student"], r["task"], r["index"]): r["reason"] for r in failed}
+    assert len(reasons) == 2 * (1 + 4)
+    assert reasons[("ann", "avoid", 0)].startswith(
+        "the task's world: world 'world99' not found; set the task's `world:` to one of world01")
+    assert reasons[("ann", "goal", 3)] == ("controller 'roslaunch motion_plan bug2.launch "
+                                           "des_x:=0 des_y:=-4': package 'motion_plan' "
+                                           "(ann/motion_plan) has no launch file 'bug2.launch'")
+    assert reasons[("bob", "goal", 0)].startswith("no package.xml and no scripts")
