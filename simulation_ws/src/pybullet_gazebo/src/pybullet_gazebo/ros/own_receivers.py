@@ -33,7 +33,7 @@ def _is_reader(thread):
 class OwnReceivers:
     def __init__(self):
         self._threads = ()
-        self._tids = []
+        self._files = {}            # reader tid -> (fd of its stat, fd of its syscall)
 
     def tids(self):
         """The native ids of the reader threads now."""
@@ -41,20 +41,36 @@ class OwnReceivers:
         if len(threads) != len(self._threads) or \
                 any(a is not b for a, b in zip(threads, self._threads)):
             self._threads = tuple(threads)
-            self._tids = [t.native_id for t in threads if t.native_id and _is_reader(t)]
-        return self._tids
+            self._open([t.native_id for t in threads if t.native_id and _is_reader(t)])
+        return list(self._files)
+
+    def _open(self, tids):
+        """Keeps the readers' /proc files open (re-read with pread: 4 us a thread against
+        18 us for open, read and close)."""
+        for tid in [t for t in self._files if t not in tids]:
+            for fd in self._files.pop(tid):
+                os.close(fd)
+        for tid in tids:
+            if tid not in self._files:
+                base = "/proc/self/task/%d/" % tid
+                try:
+                    stat = os.open(base + "stat", os.O_RDONLY)
+                except OSError:
+                    continue                              # the thread ended meanwhile
+                try:
+                    self._files[tid] = (stat, os.open(base + "syscall", os.O_RDONLY))
+                except OSError:
+                    os.close(stat)
 
     def busy(self):
         """True while a reader thread is not asleep in a socket wait."""
-        for tid in self.tids():
-            base = "/proc/self/task/%d/" % tid
+        self.tids()
+        for stat_fd, syscall_fd in self._files.values():
             try:
-                with open(base + "stat", "rb") as f:
-                    stat = f.read()
+                stat = os.pread(stat_fd, 512, 0)
                 if stat[stat.rindex(b")") + 2] != ord("S"):
                     return True
-                with open(base + "syscall", "rb") as f:
-                    call = f.read().split(None, 1)[0]
+                call = os.pread(syscall_fd, 256, 0).split(None, 1)[0]
             except (OSError, ValueError, IndexError):
                 continue                                  # the thread ended meanwhile
             if SOCKET_WAITS and (not call.lstrip(b"-").isdigit()
