@@ -84,9 +84,13 @@ class ClockTopic:
 
         self.publisher.publish(msg, share)
 
-    def publish_to_loop_nodes(self, stamp):
-        """The tick at `stamp` to the loop nodes only (lockstep)."""
-        nodes = self._loop_nodes()
+    def loop_node_names(self):
+        return self._loop_nodes()
+
+    def publish_to_loop_nodes(self, stamp, nodes=None):
+        """The tick at `stamp` to the loop nodes only, or to those of them named in `nodes`
+        (lockstep: one at a time)."""
+        nodes = self._loop_nodes() if nodes is None else nodes
         if nodes:
             self.publisher.publish(Clock(stamp), lambda c: c.endpoint_id in nodes)
 

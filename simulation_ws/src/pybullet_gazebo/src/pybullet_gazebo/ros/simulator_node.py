@@ -237,19 +237,25 @@ class SimulatorNode:
     def _settle_loop_nodes(self):
         """Lockstep: waits until the loop nodes are done with what they were sent, then
         sends them the /clock tick they still owe (that of the readings they just took in:
-        after them, so that a rospy.Rate loop it wakes reads them) and waits for that too.
-        False when physics was paused meanwhile."""
+        after them, so that a rospy.Rate loop it wakes reads them), to one node at a time,
+        waiting for each. False when physics was paused meanwhile."""
         if not (self.lockstep.unsettled or self._loop_clock is not None):
             return True
         self._watch_loop_nodes()
         if not self.lockstep.settle():
             return False
-        if self._loop_clock is not None:
-            stamp, self._loop_clock = self._loop_clock, None
+        if self._loop_clock is None:
+            return True
+        # one loop node at a time, in the order of their names: when one node's tick acts on
+        # another (bug 2 switching go to point on by a service call), which ticks first is
+        # then the same on every run, not the machine's choice
+        stamp, self._loop_clock = self._loop_clock, None
+        settled = True
+        for node in sorted(self.clock_pub.loop_node_names()):
             self.lockstep.sending()
-            self.clock_pub.publish_to_loop_nodes(stamp)
-            return self.lockstep.settle()
-        return True
+            self.clock_pub.publish_to_loop_nodes(stamp, {node})
+            settled = self.lockstep.settle() and settled
+        return settled
 
     def _watch_loop_nodes(self):
         """Lockstep watches the processes of the loop nodes. Their ids are asked again
