@@ -15,9 +15,11 @@ import threading
 import time
 import unittest
 
+import rosgraph
 import rospy
 import rostest
 from nav_msgs.msg import Odometry
+from std_srvs.srv import Empty
 
 from pybullet_gazebo.ros.testing import ContactLog, NodeLog, sim_time, wait_for_message
 
@@ -36,6 +38,19 @@ class Bug2Test(unittest.TestCase):
         cls.contacts = ContactLog()
         cls.log = NodeLog("/bug2")
         rospy.Subscriber("/odom", Odometry, cls.on_odom, queue_size=100)
+        # the world starts paused (bug2.xml) until every controller is up, so that every run
+        # starts the same way (bug 2 places the robot at its first /odom)
+        for name in ("/go_to_point_switch", "/wall_follower_switch", "/gazebo/unpause_physics"):
+            rospy.wait_for_service(name, timeout=60)
+        master = rosgraph.Master("/test_bug2")
+        deadline = time.monotonic() + 60
+        while not any(topic == "/odom" and "/bug2" in nodes
+                      for topic, nodes in master.getSystemState()[1]):
+            if time.monotonic() > deadline:
+                raise AssertionError("/bug2 did not subscribe /odom within 60 s")
+            time.sleep(0.1)
+        time.sleep(1.0)                                 # the publishers' connections are made
+        rospy.ServiceProxy("/gazebo/unpause_physics", Empty)()
         wait_for_message("/odom", Odometry, timeout=60)
         cls.log.wait_for(1, timeout=60)                 # "robot placed at (0.00, 8.00)"
         first = cls.log.since(0.0)[0]
