@@ -84,9 +84,6 @@ class ClockTopic:
 
         self.publisher.publish(msg, share)
 
-    def loop_node_names(self):
-        return self._loop_nodes()
-
     def publish_to_loop_nodes(self, stamp, nodes=None):
         """The tick at `stamp` to the loop nodes only, or to those of them named in `nodes`
         (lockstep: one at a time)."""

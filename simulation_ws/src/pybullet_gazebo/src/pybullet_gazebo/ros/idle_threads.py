@@ -62,10 +62,16 @@ SOCKET_WAITS = {
 _BUSY_STATES = (ord("R"), ord("D"))
 
 
-def _state_of(stat):
+def state_of(stat):
     """The state letter (as a byte value) of a /proc/.../stat line; its command name may hold
     spaces and parentheses, so the state is found after the last ')'."""
     return stat[stat.rindex(b")") + 2]
+
+
+def in_socket_wait(syscall):
+    """Whether a /proc/.../syscall line says its thread sleeps in a socket wait (SOCKET_WAITS)."""
+    call = syscall.split(None, 1)[0] if syscall.strip() else b""
+    return call.isdigit() and int(call) in SOCKET_WAITS
 
 
 class _Thread:
@@ -105,7 +111,7 @@ class ProcessThreads:
                 if thread is None:
                     thread = self.threads[tid] = _Thread(
                         os.open("%s/%d/stat" % (self.task_dir, tid), os.O_RDONLY))
-                running[tid] = _state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES
+                running[tid] = state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES
             except (OSError, ValueError, IndexError):
                 continue                                   # the thread ended meanwhile
         threads = self.threads
@@ -155,10 +161,9 @@ class ProcessThreads:
             return True                            # it has not run since the message
         try:
             with open("%s/%d/syscall" % (self.task_dir, tid), "rb") as f:
-                call = f.read().split(None, 1)[0]
-            if call.isdigit() and int(call) in SOCKET_WAITS:
-                return True                        # back to reading its socket
-        except (OSError, IndexError):
+                if in_socket_wait(f.read()):
+                    return True                    # back to reading its socket
+        except OSError:
             return True                            # ended
         if runs != thread.runs_seen:
             thread.runs_seen, thread.runs_seen_at = runs, spun

@@ -20,7 +20,7 @@ from rospy.impl.tcpros_base import TCPServer
 from rospy.impl.tcpros_pubsub import robust_connect_subscriber
 from rospy.impl.tcpros_service import ServiceImpl
 
-from pybullet_gazebo.ros.idle_threads import SOCKET_WAITS
+from pybullet_gazebo.ros.idle_threads import SOCKET_WAITS, in_socket_wait, state_of
 
 def _is_reader(thread):
     target = getattr(thread, "_target", None)
@@ -67,13 +67,11 @@ class OwnReceivers:
         self.tids()
         for stat_fd, syscall_fd in self._files.values():
             try:
-                stat = os.pread(stat_fd, 512, 0)
-                if stat[stat.rindex(b")") + 2] != ord("S"):
+                if state_of(os.pread(stat_fd, 512, 0)) != ord("S"):
                     return True
-                call = os.pread(syscall_fd, 256, 0).split(None, 1)[0]
+                syscall = os.pread(syscall_fd, 256, 0)
             except (OSError, ValueError, IndexError):
                 continue                                  # the thread ended meanwhile
-            if SOCKET_WAITS and (not call.lstrip(b"-").isdigit()
-                                  or int(call) not in SOCKET_WAITS):
+            if SOCKET_WAITS and not in_socket_wait(syscall):
                 return True
         return False

@@ -88,6 +88,7 @@ class SimulatorNode:
                                                                      params.lockstep_timeout)))
         self._loop_clock = None                   # lockstep: /clock the loop nodes still owe
         self._watched_key = None                  # lockstep: the loop connections watched now
+        self._watched_names = set()               # ... and their nodes
         self._bindings = {}                       # robot name -> RobotBindings
         self._running = False                     # run() is stepping
         self._tf_publisher = None
@@ -251,7 +252,7 @@ class SimulatorNode:
         # then the same on every run, not the machine's choice
         stamp, self._loop_clock = self._loop_clock, None
         settled = True
-        for node in sorted(self.clock_pub.loop_node_names()):
+        for node in sorted(self._watched_names):
             self.lockstep.sending()
             self.clock_pub.publish_to_loop_nodes(stamp, {node})
             settled = self.lockstep.settle() and settled
@@ -267,9 +268,8 @@ class SimulatorNode:
         if key == self._watched_key:
             return
         self._watched_key = key
-        names = {node for node, _ in connections}
-        self._node_processes.forget()
-        self.lockstep.watch.watch(self._node_processes.pids(names))
+        self._watched_names = names = {node for node, _ in connections}
+        self.lockstep.watch.watch(self._node_processes.find(names))
         rospy.loginfo("lockstep: waits for %s", ", ".join(
             "%s (pid %s)" % (n, self._node_processes.pid_of(n)) for n in sorted(names))
             or "no controller")
