@@ -145,3 +145,66 @@ def test_a_process_that_ended_is_dropped(child):
     worker.kill()
     worker.wait()
     assert watch.busy() is None and watch.pids == set()
+
+
+# A relay: a reader thread takes each line from stdin and hands it to the main thread, which
+# passes it through a pipe to a second process (RELAY_END) that works on it and answers. Work
+# goes from thread to thread and process to process; no one is running at the hand-offs'
+# edges for long, which a look reading thread after thread could fall between.
+RELAY = """
+import os, queue, subprocess, sys, threading
+end = subprocess.Popen([sys.executable, "-c", sys.argv[1]], stdin=subprocess.PIPE,
+                       stdout=sys.stdout, text=True)
+print("ready %d" % end.pid, flush=True)
+lines = queue.Queue()
+threading.Thread(target=lambda: [lines.put(line) for line in sys.stdin], daemon=True).start()
+while True:
+    end.stdin.write(lines.get())
+    end.stdin.flush()
+"""
+RELAY_END = """
+import sys, time
+for line in sys.stdin:
+    end = time.thread_time() + 0.002
+    while time.thread_time() < end:
+        pass
+    print("done " + line.strip(), flush=True)
+"""
+
+
+def test_work_handed_on_between_threads_and_processes_is_waited_for_to_the_end():
+    relay = subprocess.Popen([sys.executable, "-c", textwrap.dedent(RELAY),
+                              textwrap.dedent(RELAY_END)],
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        first = relay.stdout.readline().split()
+        assert first[0] == "ready"
+        watch = IdleWatch()
+        watch.watch([relay.pid, int(first[1])])
+        assert settle(watch) is None
+        for n in range(200):
+            watch.note_sent()
+            relay.stdin.write("%d\n" % n)
+            relay.stdin.flush()
+            assert settle(watch) is None
+            assert answered(relay) == ["done %d" % n], "message %d" % n
+    finally:
+        relay.kill()
+        relay.wait()
+        relay.stdin.close()
+        relay.stdout.close()
+
+
+def test_the_run_queue_counts_a_running_child(child):
+    from pybullet_gazebo.ros.idle_threads import RunQueue
+    queue = RunQueue()
+    assert queue.runnable() >= 1                   # this thread, reading it
+    spinner = child(SPIN_THEN_SLEEP, "30")
+    assert all(queue.runnable() >= 2 for _ in range(100)), spinner.pid
+    queue.close()
+
+
+@pytest.mark.parametrize("columns, backlog", [(15, (13, 14)), (13, (11,)), (11, ())])
+def test_the_kernel_backlog_columns_follow_the_kernel(columns, backlog):
+    from pybullet_gazebo.ros.idle_threads import _backlog_columns
+    assert _backlog_columns(columns) == backlog

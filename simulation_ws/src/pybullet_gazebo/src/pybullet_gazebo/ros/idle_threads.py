@@ -22,6 +22,26 @@ Why "all threads asleep" means "done with what it was sent":
   So nobody is idle while a backlog holds packets (/proc/net/softnet_stat's backlog
   column, Linux 5.10 and later; on older kernels this check is skipped).
 
+A look is not a snapshot: it reads the threads one after another, and work may pass from a
+thread not yet read to one already read (a reader thread hands a message to the main thread
+and goes back to its socket; a node answers a service call another node sleeps on). So a look
+that finds everyone idle is confirmed by a second one: every thread still asleep and none of
+them run in between (the run counts of /proc/PID/task/TID/schedstat, read before each thread's
+state in the first look, unchanged). Then there was a moment, between the two looks, when all
+slept with nothing handed on (a thread only falls asleep by running). Measured on bug 2 (four
+nodes handing work on through service calls): without the second look, one run in two took a
+switch at a different tick.
+
+The quick look. Most of the time nothing on the machine but the simulator's own loop is
+runnable: the kernel's count of runnable tasks (/proc/loadavg's fourth field, summed over the
+CPUs at one moment) is then 1, its own thread. That one read (1.5 us) stands for both looks:
+at that moment no thread of any process was running or waiting for a CPU, and no packet was in
+the backlog just read, so nothing was being handed on. Only the simulator's own readers are
+still looked at (one asleep outside a socket wait may hold a message, waiting for the GIL that
+the simulator's loop holds). When anything else runs (a controller at work, a busy loop, other
+jobs on a shared machine) the watch takes the two looks above. (A thread in an uninterruptible
+wait, D, is not counted as runnable: the quick look misses a controller blocked on its disk.)
+
 Busy loops. A thread that never sleeps (the series' go_to_point spins in
 `while not rospy.is_shutdown(): if not active_: continue` while switched off) is never idle.
 A thread seen running at every look for SPIN_WALL of wall time, having had at least
@@ -76,11 +96,13 @@ def in_socket_wait(syscall):
 
 class _Thread:
     """What the watch remembers of one thread."""
-    __slots__ = ("fd", "busy_since", "cpu_since", "spinning", "runs_at_send", "runs_seen",
+    __slots__ = ("fd", "sched_fd", "runs", "busy_since", "cpu_since", "spinning", "runs_at_send", "runs_seen",
                  "runs_seen_at")
 
-    def __init__(self, fd):
-        self.fd = fd
+    def __init__(self, fd, sched_fd):
+        self.fd = fd                # its /proc stat, for its state
+        self.sched_fd = sched_fd    # its /proc schedstat: CPU time, wait and count of runs
+        self.runs = None            # that schedstat at the last look
         self.busy_since = None      # [s] monotonic: first seen running in this streak
         self.cpu_since = 0          # [ns] its CPU time then
         self.spinning = False
@@ -109,8 +131,8 @@ class ProcessThreads:
             thread = self.threads.get(tid)
             try:
                 if thread is None:
-                    thread = self.threads[tid] = _Thread(
-                        os.open("%s/%d/stat" % (self.task_dir, tid), os.O_RDONLY))
+                    thread = self.threads[tid] = self._open(tid)
+                thread.runs = os.pread(thread.sched_fd, 128, 0)       # before its state
                 running[tid] = state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES
             except (OSError, ValueError, IndexError):
                 continue                                   # the thread ended meanwhile
@@ -144,6 +166,58 @@ class ProcessThreads:
 
     def spinners(self):
         return [tid for tid, t in self.threads.items() if t.spinning]
+
+    def running(self, tid):
+        """Whether thread `tid` (seen before) runs or waits for a CPU now."""
+        thread = self.threads.get(tid)
+        try:
+            return thread is not None and \
+                state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES
+        except (OSError, ValueError, IndexError):
+            return False
+
+    def asleep_now(self):
+        """A tid of a thread running or waiting for a CPU (or being woken), else None."""
+        for tid, thread in self.threads.items():
+            if thread.spinning:
+                continue
+            try:
+                if state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES:
+                    return tid
+            except (OSError, ValueError, IndexError):
+                continue
+        return None
+
+    def moved_since_look(self):
+        """After a look that found this process idle: a tid that is running or has run since
+        (or True for a thread that came meanwhile), None if all slept through. A process with
+        a busy loop is left to the look's rules (its threads waiting for the GIL run every
+        switch interval)."""
+        threads = self.threads
+        if any(t.spinning for t in threads.values()):
+            return None
+        try:
+            if len(os.listdir(self.task_dir)) != len(threads):
+                return True
+        except OSError:
+            return None                                    # ended: nothing left to do
+        for tid, thread in threads.items():
+            try:
+                if state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES or \
+                        os.pread(thread.sched_fd, 128, 0) != thread.runs:
+                    return tid
+            except (OSError, ValueError, IndexError):
+                continue                                   # the thread ended meanwhile
+        return None
+
+    def _open(self, tid):
+        base = "%s/%d/" % (self.task_dir, tid)
+        fd = os.open(base + "stat", os.O_RDONLY)
+        try:
+            return _Thread(fd, os.open(base + "schedstat", os.O_RDONLY))
+        except OSError:
+            os.close(fd)
+            raise
 
     def note_sent(self):
         """A message went out to this process: beside a busy loop, remember how often each
@@ -183,37 +257,67 @@ class ProcessThreads:
 
     def _forget_ended(self, present):
         for tid in [t for t in self.threads if t not in present]:
-            os.close(self.threads.pop(tid).fd)
+            thread = self.threads.pop(tid)
+            os.close(thread.fd)
+            os.close(thread.sched_fd)
 
     def close(self):
         for thread in self.threads.values():
             os.close(thread.fd)
+            os.close(thread.sched_fd)
         self.threads.clear()
 
 
-def _backlog_column():
-    """The index of softnet_stat's backlog length, or None where the kernel has none."""
-    try:
-        with open("/proc/net/softnet_stat", "rb") as f:
-            columns = len(f.readline().split())
-    except OSError:
-        return None
-    return 11 if columns >= 13 else None
+def _backlog_columns(columns):
+    """The columns of softnet_stat that count packets not yet delivered, for a line of
+    `columns` columns: from Linux 6.0 (15 columns) the input queue (13) and the queue being
+    processed (14); from 5.10 (13 columns) the input queue (11); none before."""
+    if columns >= 15:
+        return (13, 14)
+    if columns >= 13:
+        return (11,)
+    return ()
+
+
+class RunQueue:
+    """The number of runnable tasks on the machine now (running or waiting for a CPU)."""
+
+    def __init__(self):
+        try:
+            self._fd = os.open("/proc/loadavg", os.O_RDONLY)
+            self.runnable()
+        except (OSError, ValueError, IndexError):
+            self.close()
+
+    def runnable(self):
+        """The count, or None where /proc/loadavg cannot tell."""
+        if self._fd is None:
+            return None
+        return int(os.pread(self._fd, 128, 0).split()[3].split(b"/")[0])
+
+    def close(self):
+        if getattr(self, "_fd", None) is not None:
+            os.close(self._fd)
+        self._fd = None
 
 
 class KernelBacklog:
     """Packets in the CPUs' input backlogs, not yet delivered to any socket."""
 
     def __init__(self):
-        self.column = _backlog_column()
-        self._fd = os.open("/proc/net/softnet_stat", os.O_RDONLY) \
-            if self.column is not None else None
+        try:
+            with open("/proc/net/softnet_stat", "rb") as f:
+                self.columns = _backlog_columns(len(f.readline().split()))
+        except OSError:
+            self.columns = ()
+        self._fd = os.open("/proc/net/softnet_stat", os.O_RDONLY) if self.columns else None
 
     def packets(self):
         if self._fd is None:
             return 0
         data = os.pread(self._fd, 4096, 0)
-        return sum(int(line.split()[self.column], 16) for line in data.splitlines())
+        return sum(int(fields[c], 16) for fields in map(bytes.split, data.splitlines())
+                   for c in self.columns)
 
     def close(self):
         if self._fd is not None:
@@ -225,10 +329,14 @@ class IdleWatch:
     """Waits until a set of processes is idle (see the module docstring)."""
 
     POLL = 0.0001            # [s] wall between looks
+    FOLLOW = 0.01            # [s] wall: how long a wait may watch one running thread alone
+                             # (then whole looks again, which find busy loops)
 
-    def __init__(self, own_busy=lambda: False):
+    def __init__(self, own_busy=lambda: False, own_moved=lambda: False):
         self.own_busy = own_busy            # the simulator's own side (OwnReceivers.busy)
+        self.own_moved = own_moved          # ... and its second look (OwnReceivers.moved)
         self.backlog = KernelBacklog()
+        self.run_queue = RunQueue()
         self._processes = {}                # pid -> ProcessThreads
         self._round_start = 0.0             # [s] monotonic: when the present wait began
 
@@ -260,6 +368,8 @@ class IdleWatch:
         packets = self.backlog.packets()
         if packets:
             return "kernel", packets
+        if self.run_queue.runnable() == 1:              # the quick look: only this thread
+            return self._confirm_quick_look()
         for pid, process in list(self._processes.items()):
             tid = process.busy_thread(now, self._round_start)
             if tid is False:
@@ -268,18 +378,53 @@ class IdleWatch:
                 return pid, tid
         if self.own_busy():
             return "self", None
+        return self._second_look()
+
+    def _confirm_quick_look(self):
+        for pid, process in self._processes.items():
+            tid = process.asleep_now()
+            if tid is not None:
+                return pid, tid
+        if self.own_busy():
+            return "self", None
+        if self.run_queue.runnable() != 1:
+            return "machine", None
+        return None
+
+    def _second_look(self):
+        """After a look that found all idle: what has moved since (see the module docstring),
+        or None."""
+        packets = self.backlog.packets()
+        if packets:
+            return "kernel", packets
+        for pid, process in self._processes.items():
+            tid = process.moved_since_look()
+            if tid is not None:
+                return pid, tid
+        if self.own_moved():
+            return "self", None
         return None
 
     def wait(self, deadline, interrupted=lambda: False):
         """Waits until every watched process is idle (None) or the monotonic clock reaches
         `deadline` or interrupted() is true (the (pid, tid) still busy)."""
+        busy = None
+        follow_until = time.monotonic() + self.FOLLOW
         while True:
-            busy = self.busy(new_round=False)
-            if busy is None:
-                return None
+            # while one thread is at work, look at it alone (one read, not a look at all)
+            if busy is None or not self._still_running(busy) or \
+                    time.monotonic() >= follow_until:
+                busy = self.busy(new_round=False)
+                if busy is None:
+                    return None
             if time.monotonic() >= deadline or interrupted():
                 return busy
             time.sleep(self.POLL)
+
+    def _still_running(self, busy):
+        pid, tid = busy
+        process = self._processes.get(pid)
+        return process is not None and process.running(tid)
 
     def spinners(self):
         """{pid: [tid, ...]} of the threads taken for busy loops now."""
@@ -288,3 +433,4 @@ class IdleWatch:
     def close(self):
         self.watch(())
         self.backlog.close()
+        self.run_queue.close()

@@ -5,6 +5,11 @@ A node's id comes from the master (lookupNode: its XML-RPC address) and then the
 connections change (a node restarted under the same name is a new process). A node on
 another machine has no id this machine could watch, and is left out (named as such: lockstep
 then cannot wait for it); one that does not answer is left out until the next change.
+
+The master is watched beside them (MASTER): a controller's service call or parameter read goes
+through it (rospy looks a service up at every call), and while the master works on it the
+controller sleeps in a socket wait. Without the master in the watch, lockstep would step on in
+that gap, and bug 2 switching go to point on would land at a step the machine chose.
 """
 import os
 import socket
@@ -14,6 +19,7 @@ from xmlrpc.client import ServerProxy, Transport
 import rosgraph
 
 ASK_TIMEOUT = 2.0        # [s] wall: a node that does not answer getPid within this is skipped
+MASTER = "the ROS master"    # its name among the nodes found (not a node name: no '/')
 
 
 class _TimeoutTransport(Transport):
@@ -41,14 +47,19 @@ class NodeProcesses:
         self._pids = {}                 # node name -> pid, of the last find()
         self.remote = set()             # nodes on other machines: not watched
 
-    def find(self, names):
-        """The local process ids of the nodes `names` (those that could be found), asked
-        afresh; remembered for pid_of and names_of."""
+    def find(self, names, with_master=True):
+        """The local process ids of the nodes `names` (those that could be found), and of the
+        master when `names` is not empty and `with_master`, asked afresh; remembered for pid_of
+        and names_of."""
         self._pids, self.remote = {}, set()
         for name in names:
             pid = self._ask(name)
             if pid is not None:
                 self._pids[name] = pid
+        if names and with_master:
+            pid = self._ask(MASTER)
+            if pid is not None:
+                self._pids[MASTER] = pid
         return set(self._pids.values())
 
     def names_of(self, pid):
@@ -70,6 +81,8 @@ class NodeProcesses:
             return None
 
     def _lookup_uri(self, name):
+        if name == MASTER:
+            return rosgraph.get_master_uri()
         return rosgraph.Master(self.caller_id).lookupNode(name)
 
     def _pid_from_node(self, uri):

@@ -7,7 +7,9 @@ rospy thread of the simulator is reading or handling them. Those threads are ros
 receivers (one per subscribed connection), service connection handlers, and the TCPROS
 server that accepts new connections. Each is idle only when it sleeps inside a socket wait
 (recv, poll, accept ...): asleep anywhere else it may be waiting for the GIL or for the
-world's lock with a message in hand.
+world's lock with a message in hand. Like the controllers' threads, they get a second look
+(`moved`, see idle_threads.py): a reader that answered a service call and went back to its
+socket between the two has handed work on.
 
 The threads are found by what rospy runs in them (`threading.Thread._target`); the list is
 made again whenever the set of threads changes (the batch runner's next controller: its
@@ -33,7 +35,8 @@ def _is_reader(thread):
 class OwnReceivers:
     def __init__(self):
         self._threads = ()
-        self._files = {}            # reader tid -> (fd of its stat, fd of its syscall)
+        self._files = {}            # reader tid -> (fds of its stat, syscall and schedstat)
+        self._runs = {}             # reader tid -> its schedstat at the last look
 
     def tids(self):
         """The native ids of the reader threads now."""
@@ -58,15 +61,24 @@ class OwnReceivers:
                 except OSError:
                     continue                              # the thread ended meanwhile
                 try:
-                    self._files[tid] = (stat, os.open(base + "syscall", os.O_RDONLY))
+                    syscall = os.open(base + "syscall", os.O_RDONLY)
                 except OSError:
                     os.close(stat)
+                    continue
+                try:
+                    self._files[tid] = (stat, syscall, os.open(base + "schedstat", os.O_RDONLY))
+                except OSError:
+                    os.close(stat)
+                    os.close(syscall)
 
     def busy(self):
         """True while a reader thread is not asleep in a socket wait."""
         self.tids()
-        for stat_fd, syscall_fd in self._files.values():
+        runs = self._runs
+        runs.clear()
+        for tid, (stat_fd, syscall_fd, sched_fd) in self._files.items():
             try:
+                runs[tid] = os.pread(sched_fd, 128, 0)          # before its state
                 if state_of(os.pread(stat_fd, 512, 0)) != ord("S"):
                     return True
                 syscall = os.pread(syscall_fd, 256, 0)
@@ -74,4 +86,15 @@ class OwnReceivers:
                 continue                                  # the thread ended meanwhile
             if SOCKET_WAITS and not in_socket_wait(syscall):
                 return True
+        return False
+
+    def moved(self):
+        """After busy() found all readers idle: True if one has run since or is running."""
+        for tid, (stat_fd, _, sched_fd) in self._files.items():
+            try:
+                if state_of(os.pread(stat_fd, 512, 0)) != ord("S") or \
+                        os.pread(sched_fd, 128, 0) != self._runs.get(tid):
+                    return True
+            except (OSError, ValueError, IndexError):
+                continue                                  # the thread ended meanwhile
         return False

@@ -43,7 +43,7 @@ from pybullet_gazebo.ros.clock_topic import ClockTopic
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.idle_threads import IdleWatch
-from pybullet_gazebo.ros.node_processes import NodeProcesses
+from pybullet_gazebo.ros.node_processes import MASTER, NodeProcesses
 from pybullet_gazebo.ros.own_receivers import OwnReceivers
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
 from pybullet_gazebo.ros.state_topics import StateTopics
@@ -77,9 +77,11 @@ class SimulatorNode:
             else params.real_time_factor
         self.pacer = RealTimePacer(self.real_time_factor, self.world.sim_time)
         self._node_processes = NodeProcesses(rospy.get_name())
+        own_receivers = OwnReceivers()
         self.lockstep = Lockstep(
             params.lockstep, params.lockstep_timeout,
-            IdleWatch(own_busy=OwnReceivers().busy) if params.lockstep else None,
+            IdleWatch(own_busy=own_receivers.busy, own_moved=own_receivers.moved)
+            if params.lockstep else None,
             is_shutdown=rospy.is_shutdown, is_paused=lambda: self.paused,
             describe=self._describe_busy,
             on_timeout=lambda who: rospy.logwarn(
@@ -270,19 +272,24 @@ class SimulatorNode:
         self._watched_key = key
         self._watched_names = names = {node for node, _ in connections}
         self.lockstep.watch.watch(self._node_processes.find(names))
-        rospy.loginfo("lockstep: waits for %s", ", ".join(
+        rospy.loginfo("lockstep: waits for %s%s", ", ".join(
             "%s (pid %s)" % (n, self._node_processes.pid_of(n)) for n in sorted(names))
-            or "no controller")
+            or "no controller", "; and %s (pid %s), which their service calls go through" % (
+                MASTER, self._node_processes.pid_of(MASTER)) if names else "")
 
     def _describe_busy(self, busy):
         """A name for what IdleWatch.busy() found at work (for the log and the summary)."""
         pid, _ = busy
         if pid == "self":
             return "the simulator's own reader of a message"
+        if pid == "machine":
+            return "another task on the machine"
         if pid == "kernel":
             return "the kernel's delivery of packets"
         names = self._node_processes.names_of(pid)
-        return "node %s (pid %d)" % (names[0], pid) if names else "pid %s" % pid
+        if not names:
+            return "pid %s" % pid
+        return "%s%s (pid %d)" % ("node " if names[0].startswith("/") else "", names[0], pid)
 
     def _steps_ahead(self):
         """How many physics steps the loop may take in one World.advance (which stops early
