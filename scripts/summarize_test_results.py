@@ -36,14 +36,27 @@ def count(results_dir):
                                 % (suite.get("name", ""), declared - broken, path.name))
         for case in root.iter("testcase"):
             name = "%s.%s" % (case.get("classname", ""), case.get("name", ""))
-            if case.find("failure") is not None or case.find("error") is not None:
+            broken = case.find("failure")
+            broken = case.find("error") if broken is None else broken
+            if broken is not None:
                 failed += 1
-                failures.append("%s (%s)" % (name, path.name))
+                failures.append("%s (%s)%s" % (name, path.name, why(broken)))
             elif case.find("skipped") is not None:
                 skipped += 1
             else:
                 passed += 1
     return passed, failed, skipped, failures
+
+
+def why(element, lines=6):
+    """The reason a failed case gives (its message, else the end of its text), indented: CI
+    keeps only the end of the output, so the reason must be here, not only in the XML."""
+    text = (element.get("message") or "").strip()
+    body = (element.text or "").strip()
+    if body and (not text or text not in body):
+        text = (text + "\n" + body).strip()
+    kept = [line for line in text.splitlines() if line.strip()][-lines:]
+    return "".join("\n    " + line[:300] for line in kept)
 
 
 def failed_suites(results_dir):

@@ -1,0 +1,28 @@
+"""The suite's closing lines: a failed case shows its reason, not only its name (CI keeps only
+the end of the output)."""
+import subprocess
+import sys
+from pathlib import Path
+
+SCRIPT = Path(__file__).resolve().parents[1] / "summarize_test_results.py"
+
+RESULT = """<testsuite name="bug2" tests="2" failures="1" errors="0">
+<testcase classname="Bug2Test" name="test_reaches_the_goal">
+<failure type="AssertionError">Traceback (most recent call last):
+  File "test_bug2.py", line 98, in test_reaches_the_goal
+    self.assertIsNotNone(self.reached, summary)
+AssertionError: unexpectedly None : goal (0.0, -3.0): nearest 0.912 m, not reached in 300 s</failure>
+</testcase>
+<testcase classname="Bug2Test" name="test_other"/>
+</testsuite>"""
+
+
+def test_a_failure_is_printed_with_its_reason(tmp_path):
+    (tmp_path / "rosunit-bug2.xml").write_text(RESULT)
+    run = subprocess.run([sys.executable, str(SCRIPT), str(tmp_path)], capture_output=True,
+                         text=True)
+    assert run.returncode == 1
+    lines = run.stdout.splitlines()
+    assert lines[0] == "FAILED: Bug2Test.test_reaches_the_goal (rosunit-bug2.xml)"
+    assert "nearest 0.912 m, not reached in 300 s" in run.stdout
+    assert lines[-1] == "1 passed, 1 failed, 0 skipped"
