@@ -38,7 +38,8 @@ CPUs at one moment) is then 1, its own thread. That one read (1.5 us) stands for
 at that moment no thread of any process was running or waiting for a CPU, and no packet was in
 the backlog just read, so nothing was being handed on. Only the simulator's own readers are
 still looked at (one asleep outside a socket wait may hold a message, waiting for the GIL that
-the simulator's loop holds). When anything else runs (a controller at work, a busy loop, other
+the simulator's loop holds). Not beside a known busy loop, whose process's sleeping threads
+may be waiting for its GIL (the whole looks handle those). When anything else runs (a controller at work, a busy loop, other
 jobs on a shared machine) the watch takes the two looks above. (A thread in an uninterruptible
 wait, D, is not counted as runnable: the quick look misses a controller blocked on its disk.)
 
@@ -177,15 +178,16 @@ class ProcessThreads:
             return False
 
     def asleep_now(self):
-        """A tid of a thread running or waiting for a CPU (or being woken), else None."""
+        """After the quick look (no busy loop known): a tid of a thread running or waiting
+        for a CPU (or being woken), None if all sleep, False when the process is gone."""
+        if not os.path.isdir(self.task_dir):
+            return False
         for tid, thread in self.threads.items():
-            if thread.spinning:
-                continue
             try:
                 if state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES:
                     return tid
             except (OSError, ValueError, IndexError):
-                continue
+                continue                                   # the thread ended meanwhile
         return None
 
     def moved_since_look(self):
@@ -368,7 +370,7 @@ class IdleWatch:
         packets = self.backlog.packets()
         if packets:
             return "kernel", packets
-        if self.run_queue.runnable() == 1:              # the quick look: only this thread
+        if self.run_queue.runnable() == 1 and not self._spinning():   # the quick look
             return self._confirm_quick_look()
         for pid, process in list(self._processes.items()):
             tid = process.busy_thread(now, self._round_start)
@@ -380,10 +382,17 @@ class IdleWatch:
             return "self", None
         return self._second_look()
 
+    def _spinning(self):
+        """Whether a busy loop is known (its process's sleeping threads may be waiting for
+        the GIL: only the whole looks can tell, see _done_beside_spinner)."""
+        return any(t.spinning for p in self._processes.values() for t in p.threads.values())
+
     def _confirm_quick_look(self):
-        for pid, process in self._processes.items():
+        for pid, process in list(self._processes.items()):
             tid = process.asleep_now()
-            if tid is not None:
+            if tid is False:
+                self._processes.pop(pid).close()
+            elif tid is not None:
                 return pid, tid
         if self.own_busy():
             return "self", None
