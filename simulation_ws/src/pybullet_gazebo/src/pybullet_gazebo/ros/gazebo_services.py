@@ -6,8 +6,9 @@ from the World. Each family lives in its own module:
   physics_services   get/set_physics_properties, pause/unpause, resets, dynamic_reconfigure
   spawn_services     spawn_urdf_model, spawn_sdf_model, delete_model
   call_log           with /gazebo/call_log set, who called which service, at what sim time
-A request the world cannot honour answers `success: false` with a reason naming the input;
-no request, however malformed, stops the simulator (every handler catches and reports).
+A request the world cannot honour answers `success: false` with a reason naming the input
+(gazebo_answers.refuses, shared by every family); no request, however malformed, stops the
+simulator.
 
 The services see the simulator only through the narrow `Simulation` interface below (the
 simulator node implements it): the world to query and change under its lock, and the few

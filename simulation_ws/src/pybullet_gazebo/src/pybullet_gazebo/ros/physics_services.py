@@ -20,6 +20,7 @@ from gazebo_msgs.srv import (GetPhysicsProperties, GetPhysicsPropertiesResponse,
                              SetPhysicsProperties, SetPhysicsPropertiesResponse)
 from geometry_msgs.msg import Vector3
 
+from pybullet_gazebo.ros.gazebo_answers import refuses
 from pybullet_gazebo.ros.physics_reconfigure import ODE_FIELDS, PhysicsReconfigure
 
 # What a default Gazebo 11 world reports (its <physics type="ode"> defaults).
@@ -84,22 +85,19 @@ class PhysicsServices:
             "GetPhysicsProperties: got properties (Bullet physics: ode_config shows Gazebo's "
             "defaults and has no effect)")
 
+    @refuses("SetPhysicsProperties", SetPhysicsPropertiesResponse, then="; nothing changed",
+             errors=(ValueError,))
     def set_physics(self, req):
         gravity = (req.gravity.x, req.gravity.y, req.gravity.z)
         asked = {name: getattr(req.ode_config, name) for name in ODE_FIELDS}
         if asked != ODE_DEFAULTS and any(asked.values()):
             changed = ["%s %s (is %s)" % (name, asked[name], ODE_DEFAULTS[name])
                        for name in ODE_FIELDS if asked[name] != ODE_DEFAULTS[name]]
-            return SetPhysicsPropertiesResponse(
-                False, "SetPhysicsProperties: ode_config %s: ODE solver settings have no "
-                "meaning for the stand-in's Bullet physics; send the ode_config "
-                "get_physics_properties returns (or an empty one) to change time_step, "
-                "max_update_rate or gravity; nothing changed" % ", ".join(changed))
-        try:
-            self.physics.set(req.time_step, req.max_update_rate, gravity)
-        except ValueError as err:
-            return SetPhysicsPropertiesResponse(False, "SetPhysicsProperties: %s; nothing "
-                                                "changed" % err)
+            raise ValueError(
+                "ode_config %s: ODE solver settings have no meaning for the stand-in's Bullet "
+                "physics; send the ode_config get_physics_properties returns (or an empty "
+                "one) to change time_step, max_update_rate or gravity" % ", ".join(changed))
+        self.physics.set(req.time_step, req.max_update_rate, gravity)
         rospy.loginfo("set_physics_properties: time_step %g s, max_update_rate %g Hz "
                       "(real_time_factor %g), gravity %s m/s^2", req.time_step,
                       req.max_update_rate, req.time_step * req.max_update_rate, gravity)

@@ -30,6 +30,7 @@ from gazebo_msgs.srv import (DeleteLight, DeleteLightResponse, GetJointPropertie
 
 from pybullet_gazebo.engine import model_access
 from pybullet_gazebo.ros import conversions
+from pybullet_gazebo.ros.gazebo_answers import refuses
 
 JOINT_TYPES = {"revolute": GetJointPropertiesResponse.REVOLUTE,
                "continuous": GetJointPropertiesResponse.CONTINUOUS,
@@ -66,13 +67,10 @@ class PropertyServices:
                                               self.sim.gui, True,
                                               "GetWorldProperties: got properties")
 
+    @refuses("GetModelProperties", GetModelPropertiesResponse)
     def get_model_properties(self, req):
-        try:
-            with self.sim.lock:
-                props = model_access.model_properties(self.sim.world, req.model_name)
-        except LookupError as err:
-            return GetModelPropertiesResponse(success=False,
-                                              status_message="GetModelProperties: %s" % err)
+        with self.sim.lock:
+            props = model_access.model_properties(self.sim.world, req.model_name)
         return GetModelPropertiesResponse(
             parent_model_name="", canonical_body_name="", body_names=props.body_names,
             geom_names=props.geom_names, joint_names=props.joint_names, child_model_names=[],
@@ -80,85 +78,71 @@ class PropertyServices:
             status_message="GetModelProperties: got properties")
 
     # --- links ----------------------------------------------------------------------------------
+    @refuses("GetLinkProperties", GetLinkPropertiesResponse)
     def get_link_properties(self, req):
-        try:
-            with self.sim.lock:
-                ref = model_access.find_link(self.sim.world, req.link_name)
-                props = model_access.link_properties(self.sim.world, ref)
-        except LookupError as err:
-            return GetLinkPropertiesResponse(success=False,
-                                             status_message="GetLinkProperties: %s" % err)
+        with self.sim.lock:
+            ref = model_access.find_link(self.sim.world, req.link_name)
+            props = model_access.link_properties(self.sim.world, ref)
         ixx, iyy, izz = props.inertia
         return GetLinkPropertiesResponse(
             com=conversions.pose_to_msg(props.com), gravity_mode=props.gravity_mode,
             mass=props.mass, ixx=ixx, ixy=0.0, ixz=0.0, iyy=iyy, iyz=0.0, izz=izz,
             success=True, status_message="GetLinkProperties: got properties")
 
+    @refuses("SetLinkProperties", SetLinkPropertiesResponse, then="; nothing changed")
     def set_link_properties(self, req):
-        try:
-            com = conversions.pose_from_msg(req.com, zero_quaternion_is_identity=True)
-            with self.sim.lock:
-                ref = model_access.find_link(self.sim.world, req.link_name)
-                model_access.set_link_properties(
-                    self.sim.world, ref, req.mass, com, (req.ixx, req.iyy, req.izz),
-                    (req.ixy, req.ixz, req.iyz), req.gravity_mode)
-        except (LookupError, ValueError) as err:
-            return SetLinkPropertiesResponse(False, "SetLinkProperties: %s; nothing changed" % err)
+        com = conversions.pose_from_msg(req.com, zero_quaternion_is_identity=True)
+        with self.sim.lock:
+            ref = model_access.find_link(self.sim.world, req.link_name)
+            model_access.set_link_properties(
+                self.sim.world, ref, req.mass, com, (req.ixx, req.iyy, req.izz),
+                (req.ixy, req.ixz, req.iyz), req.gravity_mode)
         return SetLinkPropertiesResponse(True, "SetLinkProperties: properties set")
 
     # --- joints ---------------------------------------------------------------------------------
+    @refuses("GetJointProperties", GetJointPropertiesResponse)
     def get_joint_properties(self, req):
-        try:
-            with self.sim.lock:
-                ref = model_access.find_joint(self.sim.world, req.joint_name)
-                props = model_access.joint_properties(self.sim.world, ref)
-        except LookupError as err:
-            return GetJointPropertiesResponse(success=False,
-                                              status_message="GetJointProperties: %s" % err)
+        with self.sim.lock:
+            ref = model_access.find_joint(self.sim.world, req.joint_name)
+            props = model_access.joint_properties(self.sim.world, ref)
         return GetJointPropertiesResponse(
             type=JOINT_TYPES[props.kind], damping=[props.damping], position=[props.position],
             rate=[props.rate], success=True, status_message="GetJointProperties: got properties")
 
+    @refuses("SetJointProperties", SetJointPropertiesResponse, then="; nothing changed")
     def set_joint_properties(self, req):
         config = req.ode_joint_config
-        try:
-            with self.sim.lock:
-                ref = model_access.find_joint(self.sim.world, req.joint_name)
-                unsupported = [name for name in ODE_ONLY_JOINT_FIELDS if getattr(config, name)]
-                if unsupported:
-                    raise ValueError("%s of joint '%s' are ODE settings with no Bullet "
-                                     "counterpart (only damping, loStop and hiStop are applied)"
-                                     % (", ".join(unsupported), req.joint_name))
-                values = list(config.damping) + list(config.loStop) + list(config.hiStop)
-                if not all(math.isfinite(v) for v in values) or \
-                        any(len(getattr(config, n)) > 1 for n in ("damping", "loStop", "hiStop")):
-                    raise ValueError("damping/loStop/hiStop %s must be at most one finite "
-                                     "number each (the joint has one axis)" % (values,))
-                if any(d < 0 for d in config.damping):
-                    raise ValueError("damping %s must be >= 0" % (list(config.damping),))
-                changes = {}
-                if config.damping:
-                    changes["jointDamping"] = float(config.damping[0])
-                if config.loStop:
-                    changes["jointLowerLimit"] = float(config.loStop[0])
-                if config.hiStop:
-                    changes["jointUpperLimit"] = float(config.hiStop[0])
-                if changes:
-                    self.sim.world.client.changeDynamics(ref.body_id, ref.index, **changes)
-        except (LookupError, ValueError) as err:
-            return SetJointPropertiesResponse(False, "SetJointProperties: %s; nothing changed"
-                                              % err)
+        with self.sim.lock:
+            ref = model_access.find_joint(self.sim.world, req.joint_name)
+            unsupported = [name for name in ODE_ONLY_JOINT_FIELDS if getattr(config, name)]
+            if unsupported:
+                raise ValueError("%s of joint '%s' are ODE settings with no Bullet "
+                                 "counterpart (only damping, loStop and hiStop are applied)"
+                                 % (", ".join(unsupported), req.joint_name))
+            values = list(config.damping) + list(config.loStop) + list(config.hiStop)
+            if not all(math.isfinite(v) for v in values) or \
+                    any(len(getattr(config, n)) > 1 for n in ("damping", "loStop", "hiStop")):
+                raise ValueError("damping/loStop/hiStop %s must be at most one finite "
+                                 "number each (the joint has one axis)" % (values,))
+            if any(d < 0 for d in config.damping):
+                raise ValueError("damping %s must be >= 0" % (list(config.damping),))
+            changes = {}
+            if config.damping:
+                changes["jointDamping"] = float(config.damping[0])
+            if config.loStop:
+                changes["jointLowerLimit"] = float(config.loStop[0])
+            if config.hiStop:
+                changes["jointUpperLimit"] = float(config.hiStop[0])
+            if changes:
+                self.sim.world.client.changeDynamics(ref.body_id, ref.index, **changes)
         return SetJointPropertiesResponse(True, "SetJointProperties: properties set")
 
+    @refuses("SetModelConfiguration", SetModelConfigurationResponse, then="; nothing changed")
     def set_model_configuration(self, req):
-        try:
-            with self.sim.lock:
-                model_access.set_model_configuration(self.sim.world, req.model_name,
-                                                     list(req.joint_names),
-                                                     list(req.joint_positions))
-        except (LookupError, ValueError) as err:
-            return SetModelConfigurationResponse(False, "SetModelConfiguration: %s; nothing "
-                                                 "changed" % err)
+        with self.sim.lock:
+            model_access.set_model_configuration(self.sim.world, req.model_name,
+                                                 list(req.joint_names),
+                                                 list(req.joint_positions))
         return SetModelConfigurationResponse(True, "SetModelConfiguration: success")
 
     # --- lights ---------------------------------------------------------------------------------

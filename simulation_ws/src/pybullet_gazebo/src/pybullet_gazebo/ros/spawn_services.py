@@ -15,6 +15,7 @@ from gazebo_msgs.srv import DeleteModel, DeleteModelResponse, SpawnModel, SpawnM
 
 from pybullet_gazebo.engine import model_access
 from pybullet_gazebo.ros import conversions
+from pybullet_gazebo.ros.gazebo_answers import refuses
 
 INVALID_URDF = ("SpawnModel: Failure - entity format is invalid: model_xml of '%s' is not a "
                 "URDF: its root element is %s; call /gazebo/spawn_sdf_model for an SDF model")
@@ -89,9 +90,7 @@ class SpawnServices:
                       "; a positive angular.z turns it %s" % turning if turning else "")
         return SpawnModelResponse(True, "SpawnModel: Successfully spawned entity")
 
+    @refuses("DeleteModel", DeleteModelResponse)
     def delete_model(self, req):
-        try:
-            self.sim.delete_model(req.model_name)
-        except LookupError as err:
-            return DeleteModelResponse(False, "DeleteModel: %s" % err)
+        self.sim.delete_model(req.model_name)
         return DeleteModelResponse(True, "DeleteModel: successfully deleted model")

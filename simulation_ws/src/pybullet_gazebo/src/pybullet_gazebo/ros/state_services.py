@@ -18,6 +18,7 @@ from gazebo_msgs.srv import (GetLinkState, GetLinkStateResponse, GetModelState,
 from pybullet_gazebo.engine import model_access
 from pybullet_gazebo.engine.world import ModelNotFound
 from pybullet_gazebo.ros import conversions
+from pybullet_gazebo.ros.gazebo_answers import refuses
 
 
 def _vector(v):
@@ -40,22 +41,18 @@ class StateServices:
         ]
 
     # --- models ---------------------------------------------------------------------------------
+    @refuses("GetModelState", GetModelStateResponse)
     def get_model_state(self, req):
         response = GetModelStateResponse()
         world = self.sim.world
-        try:
-            with self.sim.lock:
-                if req.model_name not in world.entities:
-                    raise ModelNotFound("model '%s' does not exist; models are: %s"
-                                        % (req.model_name, ", ".join(world.model_names())))
-                state = model_access.model_state(world, req.model_name)
-                frame = model_access.frame_state(world, req.relative_entity_name)
-                pose, linear, angular = model_access.relative_state(state, frame)
-                stamp = self.sim.stamp()
-        except (LookupError, ValueError) as err:
-            response.success = False
-            response.status_message = "GetModelState: %s" % err
-            return response
+        with self.sim.lock:
+            if req.model_name not in world.entities:
+                raise ModelNotFound("model '%s' does not exist; models are: %s"
+                                    % (req.model_name, ", ".join(world.model_names())))
+            state = model_access.model_state(world, req.model_name)
+            frame = model_access.frame_state(world, req.relative_entity_name)
+            pose, linear, angular = model_access.relative_state(state, frame)
+            stamp = self.sim.stamp()
         count = self._get_model_count.get(req.model_name, 0) + 1
         self._get_model_count[req.model_name] = count
         response.header.seq = count
@@ -67,12 +64,10 @@ class StateServices:
         response.status_message = "GetModelState: got properties"
         return response
 
+    @refuses("SetModelState", SetModelStateResponse)
     def set_model_state(self, req):
         state = req.model_state
-        try:
-            self._set_model_state(state)
-        except (LookupError, ValueError) as err:
-            return SetModelStateResponse(False, "SetModelState: %s" % err)
+        self._set_model_state(state)
         return SetModelStateResponse(True, "SetModelState: set model state done")
 
     def _set_model_state(self, state):
@@ -92,19 +87,15 @@ class StateServices:
             rospy.logwarn_throttle_identical(5.0, "/gazebo/set_model_state message ignored: %s" % err)
 
     # --- links ----------------------------------------------------------------------------------
+    @refuses("GetLinkState", GetLinkStateResponse)
     def get_link_state(self, req):
         response = GetLinkStateResponse()
         world = self.sim.world
-        try:
-            with self.sim.lock:
-                ref = model_access.find_link(world, req.link_name)
-                state = model_access.link_state(world, ref)
-                frame = model_access.frame_state(world, req.reference_frame)
-                pose, linear, angular = model_access.relative_state(state, frame)
-        except (LookupError, ValueError) as err:
-            response.success = False
-            response.status_message = "GetLinkState: %s" % err
-            return response
+        with self.sim.lock:
+            ref = model_access.find_link(world, req.link_name)
+            state = model_access.link_state(world, ref)
+            frame = model_access.frame_state(world, req.reference_frame)
+            pose, linear, angular = model_access.relative_state(state, frame)
         response.link_state.link_name = req.link_name
         response.link_state.pose = conversions.pose_to_msg(pose)
         response.link_state.twist = conversions.twist_to_msg(linear, angular)
@@ -113,11 +104,9 @@ class StateServices:
         response.status_message = "GetLinkState: got state"
         return response
 
+    @refuses("SetLinkState", SetLinkStateResponse)
     def set_link_state(self, req):
-        try:
-            self._set_link_state(req.link_state)
-        except (LookupError, ValueError) as err:
-            return SetLinkStateResponse(False, "SetLinkState: %s" % err)
+        self._set_link_state(req.link_state)
         return SetLinkStateResponse(True, "SetLinkState: success")
 
     def _set_link_state(self, state):

@@ -22,6 +22,7 @@ from gazebo_msgs.srv import (ApplyBodyWrench, ApplyBodyWrenchResponse, ApplyJoin
                              JointRequest, JointRequestResponse)
 
 from pybullet_gazebo.engine import model_access
+from pybullet_gazebo.ros.gazebo_answers import refuses
 
 MAX_WRENCH = 1.0e9          # [N] and [N m]: Bullet's state turns to NaN far beyond
 
@@ -45,27 +46,25 @@ class WrenchServices:
             rospy.Service("~clear_joint_forces", JointRequest, self.clear_joint_forces),
         ]
 
+    @refuses("ApplyBodyWrench", ApplyBodyWrenchResponse, then="; nothing applied")
     def apply_body_wrench(self, req):
         world = self.sim.world
-        try:
-            force = _finite((req.wrench.force.x, req.wrench.force.y, req.wrench.force.z),
-                            "wrench.force")
-            torque = _finite((req.wrench.torque.x, req.wrench.torque.y, req.wrench.torque.z),
-                             "wrench.torque")
-            point = _finite((req.reference_point.x, req.reference_point.y,
-                             req.reference_point.z), "reference_point")
-            with self.sim.lock:
-                ref = model_access.find_link(world, req.body_name)
-                frame = model_access.frame_state(world, req.reference_frame)
-                torque = torque + np.cross(point, force)
-                if frame is not None:
-                    rotation = frame[0].matrix
-                    force, torque = rotation @ force, rotation @ torque
-                world.wrenches.add_body_wrench(ref.scoped, ref.body_id, ref.link_index, force,
-                                               torque, req.start_time.to_sec(),
-                                               req.duration.to_sec(), world.sim_time)
-        except (LookupError, ValueError) as err:
-            return ApplyBodyWrenchResponse(False, "ApplyBodyWrench: %s; nothing applied" % err)
+        force = _finite((req.wrench.force.x, req.wrench.force.y, req.wrench.force.z),
+                        "wrench.force")
+        torque = _finite((req.wrench.torque.x, req.wrench.torque.y, req.wrench.torque.z),
+                         "wrench.torque")
+        point = _finite((req.reference_point.x, req.reference_point.y,
+                         req.reference_point.z), "reference_point")
+        with self.sim.lock:
+            ref = model_access.find_link(world, req.body_name)
+            frame = model_access.frame_state(world, req.reference_frame)
+            torque = torque + np.cross(point, force)
+            if frame is not None:
+                rotation = frame[0].matrix
+                force, torque = rotation @ force, rotation @ torque
+            world.wrenches.add_body_wrench(ref.scoped, ref.body_id, ref.link_index, force,
+                                           torque, req.start_time.to_sec(),
+                                           req.duration.to_sec(), world.sim_time)
         return ApplyBodyWrenchResponse(True, "")
 
     def clear_body_wrenches(self, req):
@@ -78,17 +77,15 @@ class WrenchServices:
             self.sim.world.wrenches.clear_body_wrenches(name)
         return BodyRequestResponse()
 
+    @refuses("ApplyJointEffort", ApplyJointEffortResponse, then="; nothing applied")
     def apply_joint_effort(self, req):
         world = self.sim.world
-        try:
-            effort = _finite((req.effort,), "effort")[0]
-            with self.sim.lock:
-                ref = model_access.find_joint(world, req.joint_name)
-                world.wrenches.add_joint_effort(ref.scoped, ref.body_id, ref.index, effort,
-                                                req.start_time.to_sec(), req.duration.to_sec(),
-                                                world.sim_time)
-        except (LookupError, ValueError) as err:
-            return ApplyJointEffortResponse(False, "ApplyJointEffort: %s; nothing applied" % err)
+        effort = _finite((req.effort,), "effort")[0]
+        with self.sim.lock:
+            ref = model_access.find_joint(world, req.joint_name)
+            world.wrenches.add_joint_effort(ref.scoped, ref.body_id, ref.index, effort,
+                                            req.start_time.to_sec(), req.duration.to_sec(),
+                                            world.sim_time)
         return ApplyJointEffortResponse(True, "ApplyJointEffort: effort set")
 
     def clear_joint_forces(self, req):
