@@ -8,6 +8,9 @@
 #   scripts/bench.sh --bug [--worlds world02 world03] [--output output/]
 #     the series' bug-2 runs in lockstep (m2wr_tools.bench_bug): x real time, lockstep
 #     time-outs, contact events
+#   scripts/bench.sh --grade [--students 30] [--workers N] [--output output/]
+#     a class of N students graded with the default spec (m2wr_tools.bench_grade): wall
+#     time, runs a minute, the grader's overhead a run beside the batch runner's
 # Prints the figures side by side and writes them to output/bench.json. Runs
 # scripts/setup.sh first unless the project is already set up, and sources scripts/env.sh.
 set -euo pipefail
@@ -16,5 +19,9 @@ source "$ROOT/scripts/ensure_ready.sh" bench
 if [ "${1:-}" = "--bug" ]; then
   shift
   exec python -m m2wr_tools.bench_bug "$@"
+fi
+if [ "${1:-}" = "--grade" ]; then
+  shift
+  exec python -m m2wr_tools.bench_grade "$@"
 fi
 exec python -m m2wr_tools.bench "$@"

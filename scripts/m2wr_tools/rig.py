@@ -394,13 +394,8 @@ class Rig:
         from . import zygote
         session = self.session
         if warm and zygote.warm_script(argv, session.env.get("PATH", os.defpath)):
-            if self.zygote is None or not self.zygote.running():
-                if self.zygote is not None:
-                    self.zygote.close()
-                self.zygote = zygote.Zygote(session.env, os.path.join(session.log_dir,
-                                                                      "zygote.log"))
             try:
-                child = self.zygote.start("controller", argv, session.env, log_path)
+                child = self._zygote().start("controller", argv, session.env, log_path)
             except RuntimeError:
                 self.zygote.close()
                 self.zygote = None               # a plain start below; a new zygote next run
@@ -409,6 +404,16 @@ class Rig:
                 return child
         return session.start_controller(argv, log_name=os.path.relpath(log_path[:-4],
                                                                        session.log_dir))
+
+    def _zygote(self):
+        """The worker's warm zygote (m2wr_tools.zygote), started anew if it is not running."""
+        from . import zygote
+        if self.zygote is None or not self.zygote.running():
+            if self.zygote is not None:
+                self.zygote.close()
+            self.zygote = zygote.Zygote(self.session.env,
+                                        os.path.join(self.session.log_dir, "zygote.log"))
+        return self.zygote
 
     def _wait(self, condition, timeout, what):
         deadline = time.monotonic() + timeout

@@ -22,8 +22,16 @@ given as `PYTHON SCRIPT ARGS` or as an executable script whose `#!` line names `
 Anything else (a binary, roslaunch, a bash script, another Python) runs as a plain
 subprocess.
 
+For the grader, a child can also start as another user in a folder of its own with resource
+limits (`start(..., cwd=, user=, group=, rlimits=)`): set in the child after the fork, before
+the program's first line, as prlimit and a change of user would set them for a new process.
+The zygote runs as the worker's user (root, where the grader isolates runs); a child that
+drops to the run's user keeps nothing of root's (no supplementary groups, real and effective
+ids both changed).
+
 Protocol (between `Zygote` in the batch worker and `serve` in the zygote process, over a
-socket pair, one JSON object a line): -> {"run": [argv...], "log": path, "env": {...}} ;
+socket pair, one JSON object a line): -> {"run": [argv...], "log": path, "env": {...},
+optionally "cwd": path, "uid": N, "gid": N, "rlimits": [[name, value], ...]} ;
 <- {"pid": N} or {"error": text}; later <- {"spinning": N} when child N first enters
 rospy.spin() (its node is set up), and {"exit": N, "pid": N} when it ends.
 """
@@ -137,10 +145,20 @@ class Zygote:
         with self._answer:                       # the zygote is gone
             self._answer.notify_all()
 
-    def start(self, name, argv, env, log_path, timeout=10.0):
+    def start(self, name, argv, env, log_path, timeout=10.0, cwd=None, user=None, group=None,
+              rlimits=()):
         """A child running `argv` (warm_script must accept it) with `env`, output to
-        log_path; a ZygoteChild. RuntimeError when the zygote cannot start it."""
-        request = json.dumps({"run": list(argv), "env": dict(env), "log": log_path}) + "\n"
+        log_path; a ZygoteChild. RuntimeError when the zygote cannot start it. `cwd`: its
+        working folder; `user`, `group`: the ids it runs as; `rlimits`: (name, value) pairs
+        of the resource module's RLIMIT_* limits, soft and hard."""
+        request = {"run": list(argv), "env": dict(env), "log": log_path}
+        if cwd is not None:
+            request["cwd"] = cwd
+        if user is not None:
+            request.update(uid=int(user), gid=int(group if group is not None else user))
+        if rlimits:
+            request["rlimits"] = [[name, int(value)] for name, value in rlimits]
+        request = json.dumps(request) + "\n"
         with self._lock:
             try:
                 self._socket.sendall(request.encode("utf-8"))
@@ -359,9 +377,24 @@ def _fork(request, channel, own_fds):
         os.dup2(log, 2)
         os.close(null)
         os.close(log)
+        _confine(request)
         code = _run_script(*found, env, spin_write)
     finally:
         os._exit(code)
+
+
+def _confine(request):
+    """The request's limits, folder and user, in the child, before the program runs (limits
+    first: lowering them needs no privilege, but the user change drops what raising would)."""
+    import resource
+    for name, value in request.get("rlimits", ()):
+        resource.setrlimit(getattr(resource, name), (value, value))
+    if "cwd" in request:
+        os.chdir(request["cwd"])
+    if "uid" in request:
+        os.setgroups([])
+        os.setgid(request["gid"])
+        os.setuid(request["uid"])                 # real, effective and saved: no way back
 
 
 def _run_script(script, args, env, spin_fd):

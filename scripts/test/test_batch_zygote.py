@@ -2,8 +2,10 @@
 sys.path, environment, output to its log, exit status, signals), and commands it cannot run
 warm are recognised."""
 import os
+import shutil
 import signal
 import sys
+import tempfile
 import time
 
 import pytest
@@ -119,3 +121,44 @@ def test_only_python_scripts_of_this_interpreter_run_warm(tmp_path):
     assert zygote.warm_script([str(shell)], path_env) is None
     assert zygote.warm_script(["roslaunch", "pkg", "x.launch"], path_env) is None
     assert zygote.warm_script([], path_env) is None
+
+
+CONFINED = """#!/usr/bin/env python3
+import os, resource
+print("cwd", os.getcwd())
+print("ids", os.getuid(), os.geteuid(), os.getgid(), os.getgroups())
+print("cpu", resource.getrlimit(resource.RLIMIT_CPU))
+print("fsize", resource.getrlimit(resource.RLIMIT_FSIZE))
+try:
+    os.setuid(0)
+    print("back to root")
+except PermissionError:
+    print("no way back")
+"""
+
+
+def test_a_graded_child_starts_with_its_folder_limits_and_user(warm):
+    """What the grader asks of a warm start: the run's folder, the spec's limits and, as
+    root, the run's unprivileged user (here `nobody`), with no way back to root."""
+    z, _, env, tmp_path = warm
+    user = 65534 if os.geteuid() == 0 else None            # nobody
+    folder = tempfile.mkdtemp(prefix="m2wr-zygote-test-")   # pytest's tmp is root's only
+    try:
+        script = os.path.join(folder, "confined.py")
+        with open(script, "w") as out:
+            out.write(CONFINED)
+        os.chmod(script, 0o755)
+        if user is not None:
+            os.chown(folder, user, user)
+            os.chmod(folder, 0o700)
+        log = str(tmp_path / "confined.log")
+        child = z.start("controller", [script], env, log, cwd=folder, user=user, group=user,
+                        rlimits=[("RLIMIT_CPU", 7), ("RLIMIT_FSIZE", 1 << 20)])
+        assert child.wait(20.0) == 0, read(log)
+        out = read(log)
+        assert "cwd %s" % folder in out
+        assert "cpu (7, 7)" in out and "fsize (1048576, 1048576)" in out
+        if user is not None:
+            assert "ids 65534 65534 65534 []" in out and "no way back" in out
+    finally:
+        shutil.rmtree(folder)

@@ -214,3 +214,22 @@ def test_runs_that_cannot_start_fail_with_their_reason_and_the_rest_are_planned(
                                            "des_x:=0 des_y:=-4': package 'motion_plan' "
                                            "(ann/motion_plan) has no launch file 'bug2.launch'")
     assert reasons[("bob", "goal", 0)].startswith("no package.xml and no scripts")
+
+
+def test_a_project_closed_to_other_users_is_named():
+    """Runs start as unprivileged users: a project under a private folder (mktemp -d, a home
+    folder) would hide m2wr_description and the project's Python from them."""
+    import shutil
+    import tempfile
+    from m2wr_tools.grade import sandbox
+    top = tempfile.mkdtemp(prefix="m2wr-closed-test-")       # under /tmp (o+x)
+    try:
+        project = os.path.join(top, "private", "project")
+        os.makedirs(project)
+        os.chmod(top, 0o755)
+        os.chmod(os.path.join(top, "private"), 0o700)
+        assert sandbox.closed_to_others(project) == os.path.join(top, "private")
+        os.chmod(os.path.join(top, "private"), 0o711)
+        assert sandbox.closed_to_others(project) is None
+    finally:
+        shutil.rmtree(top)

@@ -40,6 +40,9 @@ def parse_args(argv):
     parser.add_argument("--workers", type=int, help="LocalCluster workers (default: cores)")
     parser.add_argument("--fresh", action="store_true", help="grade again from scratch")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--cold-start", action="store_true",
+                        help="start Python controllers as new interpreters through prlimit, "
+                             "not forked from a warm one (same limits and user either way)")
     parser.add_argument("--replay", nargs=3, metavar=("STUDENT", "TASK", "RUN"),
                         help="run one graded run again and draw it")
     parser.add_argument("--gui", action="store_true", help="--replay: show the simulator")
@@ -77,8 +80,12 @@ def main(argv=None):
         except (SpecError, ValueError) as err:
             sys.stderr.write("grade: %s\n" % err)
             return 2
-        from .grading import grade_class
-        graded = grade_class(spec, submissions, args, say)
+        from .grading import GradeError, grade_class
+        try:
+            graded = grade_class(spec, submissions, args, say)
+        except GradeError as err:
+            sys.stderr.write("grade: %s\n" % err)
+            return 2
         from . import report
         report.write(args.output, spec, graded)
         say("class table %s" % os.path.join(args.output, "index.html"))

@@ -19,6 +19,7 @@ from ..commands import check
 from ..metrics import Task
 from . import classroom, sandbox
 from .runner import GradedScenario, GradeOptions, grade_run
+from ..paths import ROOT
 
 
 def _world_problem(world, cache={}):
@@ -41,6 +42,10 @@ def _record(scenario, reason):
             "yaw": scenario.yaw, "seed": scenario.seed, "task": scenario.task_name,
             "student": scenario.student, "index": scenario.index, "success": False,
             "reason": reason, "findings": [], "path": []}
+
+
+class GradeError(RuntimeError):
+    """The class cannot be graded as set up (the message says what to change)."""
 
 
 def _private(folder, isolating):
@@ -91,6 +96,13 @@ def grade_class(spec, submissions, args, say):
     output = args.output
     _private(output, sandbox.isolating())
     if sandbox.isolating():
+        closed = sandbox.closed_to_others(ROOT)
+        if closed:
+            raise GradeError(
+                "the runs' users cannot reach the project at %s: %s is closed to other users "
+                "(mode %s), so a run could not find m2wr_description or the project's Python; "
+                "chmod o+x %s, or keep the project where others may pass (not in a private "
+                "home folder)" % (ROOT, closed, oct(os.stat(closed).st_mode & 0o777), closed))
         mode = os.stat(args.class_dir).st_mode
         if mode & (stat.S_IROTH | stat.S_IXOTH):
             say("warning: %s is readable by other users: a submission could read the others "
@@ -113,7 +125,8 @@ def grade_class(spec, submissions, args, say):
             passed = sum(1 for r in done[student] if r.get("success"))
             bar.write("[grade] %s: %d runs graded, %d passed" % (student, len(done[student]),
                                                                  passed), file=sys.stderr)
-    options = GradeOptions(output=os.path.join(output, "batch"), warm_start=False,
+    options = GradeOptions(output=os.path.join(output, "batch"),
+                           warm_start=not getattr(args, "cold_start", False),
                            shadowed=shadowed, cpu_s=spec.limits.cpu_s,
                            memory_mib=spec.limits.memory_mib,
                            processes=spec.limits.processes, file_mib=spec.limits.file_mib)

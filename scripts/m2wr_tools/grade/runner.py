@@ -16,16 +16,18 @@ What GradeRig adds to a run:
            group); the simulator's call log read from where the run began; findings judged:
            a rule broken or the memory limit passed fails the run with that reason
 The record gets: student, task, index, findings (each rule finding), user, isolated,
-memory_peak_mib, leftovers (processes that outlived the controller's stop).
+memory_peak_mib, leftovers (processes that outlived the controller's stop), grader_s (the
+wall time of what the grader adds around the batch runner's run: files in and out, the end).
 """
 from dataclasses import asdict, dataclass, fields
 import hashlib
 import json
 import os
+import time
 import xmlrpc.client
 from typing import Tuple
 
-from .. import processes
+from .. import processes, zygote
 from ..metrics import Task
 from ..rig import NODE, Rig, RunOptions, run_on
 from ..scenarios import Scenario
@@ -94,14 +96,21 @@ class GradeRig(Rig):
 
     # --- one run --------------------------------------------------------------------------
     def run(self, scenario, options):
+        began = time.monotonic()
         folder = sandbox.prepare(self.slot, scenario.student, scenario.packages)
         self.current = _Run(scenario, options, folder)
+        inner = None
         try:
+            inner = time.monotonic()
             record = super().run(scenario, options)
+            inner = time.monotonic() - inner
         finally:
             current, self.current = self.current, None
             current.finish(self)
             sandbox.remove(folder)
+        # the grader's own part of the run [s wall], beside the batch runner's overhead_s:
+        # the student's files copied in and removed, the last look, the end by PID
+        record["grader_s"] = round(time.monotonic() - began - inner, 3)
         record.update(student=scenario.student, task=scenario.task_name, index=scenario.index,
                       user=self.slot.name, isolated=sandbox.isolating(),
                       findings=current.findings, memory_peak_mib=current.peak_mib,
@@ -125,15 +134,31 @@ class GradeRig(Rig):
         return argv
 
     def _start_controller(self, argv, log_path, warm):
+        """The student's command with the run's limits, folder and user: a Python script
+        (`rosrun PKG SCRIPT.py`, resolved in their packages) forked from the worker's warm
+        zygote, which sets them in the child before the script's first line, as the batch
+        runner starts its controllers; anything else (roslaunch, a binary) through prlimit."""
         run = self.current
         env = run.env(self)
         run.calls_from = _size(self._call_log())
         run.master = xmlrpc.client.ServerProxy(self.session.master_uri)
-        child = processes.Child("controller", sandbox.limited(argv, run.options.limits,
-                                                                sandbox.isolating()), env,
-                                log_path, cwd=run.folder,
-                                user=self.slot.uid if sandbox.isolating() else None,
-                                group=self.slot.gid if sandbox.isolating() else None)
+        isolating = sandbox.isolating()
+        user = self.slot.uid if isolating else None
+        group = self.slot.gid if isolating else None
+        child = None
+        if warm and zygote.warm_script(argv, env.get("PATH", os.defpath)):
+            try:
+                child = self._zygote().start("controller", argv, env, log_path,
+                                             cwd=run.folder, user=user, group=group,
+                                             rlimits=sandbox.rlimits(run.options.limits,
+                                                                     isolating))
+            except RuntimeError:
+                self.zygote.close()
+                self.zygote = None          # a plain start below; a new zygote next run
+        if child is None:
+            child = processes.Child("controller", sandbox.limited(argv, run.options.limits,
+                                                                    isolating), env,
+                                    log_path, cwd=run.folder, user=user, group=group)
         self.session.children["controller"] = child
         run.watch(self, child)
         return child

@@ -8,9 +8,12 @@ packages in a folder of its own (mode 0700, owned by that user) under RUNS_DIR (
 runs cannot list each other); the class folder, the grader's output and the other runs'
 folders are not readable by it (the grader makes its output 0700 and warns when CLASS_DIR
 is readable by others). Every process of the run:
-  - starts through `prlimit` with RLIMIT_CPU (CPU seconds a process), RLIMIT_AS (address
-    space a process), RLIMIT_NPROC (processes and threads of the user), RLIMIT_FSIZE
-    (largest file) and no core dumps; in a process group of its own;
+  - starts with RLIMIT_CPU (CPU seconds a process), RLIMIT_AS (address space a process),
+    RLIMIT_NPROC (processes and threads of the user), RLIMIT_FSIZE (largest file) and no
+    core dumps (`rlimits`), in a process group of its own: a Python script forked from the
+    worker's warm zygote, which sets them and the user in the child before the script's
+    first line (m2wr_tools.zygote), anything else through `prlimit` (`limited`); what the
+    child runs starts as the user either way;
   - is watched (Watchdog, every WATCH_PERIOD s): the resident memory of all the user's
     processes together over the limit ends them all at once (a fork-and-allocate loop
     cannot take the machine's memory before the next look);
@@ -27,6 +30,7 @@ import os
 import pwd
 import shutil
 import signal
+import stat
 import subprocess
 import threading
 import time
@@ -118,14 +122,33 @@ def environment(env, folder):
     return dict(env, HOME=home, ROS_HOME=home, ROS_LOG_DIR=os.path.join(home, "log"))
 
 
+def closed_to_others(path):
+    """The first folder on the way to `path` (itself included) that other users cannot pass
+    (no o+x), or None: a run's user must reach the project's packages and Python."""
+    path = os.path.abspath(path)
+    folders = [path]
+    while os.path.dirname(folders[-1]) != folders[-1]:
+        folders.append(os.path.dirname(folders[-1]))
+    for folder in reversed(folders):
+        if not os.stat(folder).st_mode & stat.S_IXOTH:
+            return folder
+    return None
+
+
+def rlimits(limits, own_user):
+    """The spec's limits (spec.Limits) as (RLIMIT_* name, value) pairs, soft = hard.
+    RLIMIT_NPROC counts every process of the user, so it is set only when the run has a user
+    of its own (`own_user`)."""
+    pairs = [("RLIMIT_CPU", max(1, int(limits.cpu_s))), ("RLIMIT_AS", ADDRESS_SPACE_MIB * MIB)]
+    if own_user:
+        pairs.append(("RLIMIT_NPROC", int(limits.processes)))
+    return pairs + [("RLIMIT_FSIZE", int(limits.file_mib * MIB)), ("RLIMIT_CORE", 0)]
+
+
 def limited(argv, limits, own_user):
-    """`argv` started through prlimit with the spec's limits (spec.Limits). RLIMIT_NPROC
-    counts every process of the user, so it is set only when the run has a user of its own
-    (`own_user`)."""
-    nproc = ["--nproc=%d" % limits.processes] if own_user else []
-    return ["prlimit", "--cpu=%d" % max(1, int(limits.cpu_s)),
-            "--as=%d" % (ADDRESS_SPACE_MIB * MIB)] + nproc + [
-            "--fsize=%d" % int(limits.file_mib * MIB), "--core=0", "--"] + list(argv)
+    """`argv` started through prlimit with the limits of `rlimits`."""
+    return ["prlimit"] + ["--%s=%d" % (name[len("RLIMIT_"):].lower(), value)
+                          for name, value in rlimits(limits, own_user)] + ["--"] + list(argv)
 
 
 def pids_of_user(uid):

@@ -1,0 +1,199 @@
+"""The grader's benchmark: a class of N students graded with the default spec (episodes 5-10),
+its wall time and runs per minute, and the grader's own overhead per run beside the batch
+runner's on the same controller.
+
+The class is made here: each student a `motion_plan` package as the series lays it out,
+written from the project's programs (the tutorial's obstacle_avoidance.py, and the series-style
+go to point, wall follower and bug 2 of catkin_ws/src/motion_plan/test/series_style/ under the
+series' file names, with a bug2.launch). Like most classes, it hands in no bug 0 or bug 1:
+those two tasks fail at once ("no launch file"), as they would for a real student.
+
+Overhead [s wall] is a run's wall time less the part in which the world ran (the record's
+overhead_s, see m2wr_tools.rig: resetting the world, starting and stopping the controller,
+measuring) plus, for the grader, what it adds around the run (grader_s: the student's files
+copied in and out, the rules' last look, the end by PID). Medians: a worker's first run also
+starts its simulator. For the comparison both sides grade the same 60 s obstacle avoider from (0, 8) in
+world02 with the same number of workers; the batch runner through scripts/evaluate.sh.
+
+    scripts/bench.sh --grade [--students 30] [--workers 2] [--output output/]
+
+Prints the figures and writes <output>/bench_grade.json.
+"""
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+from .paths import ROOT
+
+SERIES_STYLE = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "test", "series_style")
+TUTORIAL = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "scripts",
+                        "obstacle_avoidance.py")
+SCRIPTS = {                      # the student's file name: where its text comes from
+    "obstacle_avoidance.py": TUTORIAL,
+    "go_to_point.py": os.path.join(SERIES_STYLE, "series_style_go_to_point.py"),
+    "follow_wall.py": os.path.join(SERIES_STYLE, "series_style_follow_wall.py"),
+    "bug2.py": os.path.join(SERIES_STYLE, "series_style_bug2.py"),
+}
+PACKAGE_XML = """<?xml version="1.0"?>
+<package format="2">
+  <name>motion_plan</name>
+  <version>0.0.0</version>
+  <description>{student}'s programs for the series' episodes 5-10</description>
+  <maintainer email="{student}@example.com">{student}</maintainer>
+  <license>BSD</license>
+  <buildtool_depend>catkin</buildtool_depend>
+  <exec_depend>rospy</exec_depend>
+</package>
+"""
+BUG2_LAUNCH = """<?xml version="1.0"?>
+<launch>
+  <arg name="des_x" default="0"/>
+  <arg name="des_y" default="-4"/>
+  <param name="initial_x" value="0"/>
+  <param name="initial_y" value="8"/>
+  <param name="des_pos_x" value="$(arg des_x)"/>
+  <param name="des_pos_y" value="$(arg des_y)"/>
+  <node pkg="motion_plan" type="go_to_point.py" name="go_to_point" output="screen">
+    <param name="turn_sign" value="-1"/>
+  </node>
+  <node pkg="motion_plan" type="follow_wall.py" name="follow_wall" output="screen">
+    <param name="turn_sign" value="-1"/>
+  </node>
+  <node pkg="motion_plan" type="bug2.py" name="bug2" output="screen"/>
+</launch>
+"""
+DURATION = 60.0                  # [s sim] the compared task: the spec's ep5_avoid
+
+
+def make_class(folder, students):
+    """`students` packages under `folder` (made afresh), named student01..."""
+    shutil.rmtree(folder, ignore_errors=True)
+    names = ["student%02d" % (i + 1) for i in range(students)]
+    for name in names:
+        package = os.path.join(folder, name, "motion_plan")
+        os.makedirs(os.path.join(package, "scripts"))
+        os.makedirs(os.path.join(package, "launch"))
+        with open(os.path.join(package, "package.xml"), "w") as out:
+            out.write(PACKAGE_XML.format(student=name))
+        for script, source in SCRIPTS.items():
+            with open(source) as text:
+                body = text.read()
+            # episodes 6 and 7 run them on their own: switched on from the start
+            if script == "go_to_point.py":
+                body = body.replace('get_param("~active", False)', 'get_param("~active", True)')
+            if script == "follow_wall.py":
+                body = body.replace("\nactive_ = False\n", "\nactive_ = True\n")
+            path = os.path.join(package, "scripts", script)
+            with open(path, "w") as out:
+                out.write(body)
+            os.chmod(path, 0o755)
+        with open(os.path.join(package, "launch", "bug2.launch"), "w") as out:
+            out.write(BUG2_LAUNCH)
+    os.chmod(folder, 0o700)
+    return names
+
+
+def _run(argv, what):
+    started = time.monotonic()
+    print("[bench_grade] %s: %s" % (what, " ".join(argv)), flush=True)
+    done = subprocess.run(argv, cwd=ROOT)
+    if done.returncode != 0:
+        raise SystemExit("[bench_grade] %s failed (exit %d)" % (what, done.returncode))
+    return time.monotonic() - started
+
+
+def _records(results_path):
+    with open(results_path) as source:
+        data = json.load(source)
+    return [r for student in data["students"].values() for r in student["runs"]]
+
+
+def _median(values):
+    values = [v for v in values if v is not None]
+    return round(statistics.median(values), 3) if values else None
+
+
+def _overheads(records, task=None):
+    """Each run's overhead [s wall]: the rig's (overhead_s) and, for a graded run, what the
+    grader adds around it (grader_s)."""
+    return [r["overhead_s"] + (r.get("grader_s") or 0.0) for r in records
+            if (task is None or r.get("task") == task) and r.get("overhead_s") is not None]
+
+
+def _stage_medians(records):
+    names = sorted({k for r in records for k in (r.get("stages") or {})})
+    return {k: _median([(r.get("stages") or {}).get(k) for r in records]) for k in names}
+
+
+def bench(args):
+    output = os.path.abspath(args.output)
+    os.makedirs(output, exist_ok=True)
+    class_dir = os.path.join(output, "bench_grade_class")
+    names = make_class(class_dir, args.students)
+    grade_out = os.path.join(output, "bench_grade")
+    workers = ["--workers", str(args.workers)] if args.workers else []
+    wall = _run([sys.executable, "-m", "m2wr_tools.grade.cli", class_dir, "--output", grade_out,
+                 "--fresh"] + workers, "grading %d students" % len(names))
+    records = _records(os.path.join(grade_out, "results.json"))
+    graded = [r for r in records if r.get("overhead_s") is not None]
+    ep5 = [r for r in graded if r.get("task") == "ep5_avoid"]
+    # the batch runner on the same controller, as many runs as the class had of ep5
+    evaluate_out = os.path.join(output, "bench_grade_evaluate")
+    _run([sys.executable, "-m", "m2wr_tools.evaluate", "--controller", TUTORIAL,
+          "--task", "wander", "--world", "world02", "--duration", str(DURATION),
+          "--seeds"] + [str(i) for i in range(max(1, len(ep5)))] + ["--start", "0", "8", "0",
+          "--output", evaluate_out, "--fresh", "--no-progress"] + workers,
+         "the batch runner on the same controller")
+    with open(os.path.join(evaluate_out, "results.json")) as source:
+        batch = [r for r in json.load(source)["runs"] if r.get("overhead_s") is not None]
+    figures = {
+        "students": len(names), "runs": len(records), "graded_runs": len(graded),
+        "workers": args.workers, "wall_s": round(wall, 1),
+        "runs_per_minute": round(len(records) / wall * 60.0, 2),
+        "grader_overhead_s_median": _median(_overheads(graded)),
+        "grader_overhead_s_median_ep5": _median(_overheads(ep5)),
+        "batch_overhead_s_median": _median(_overheads(batch)),
+        "grader_stages_ep5": _stage_medians(ep5),
+        "batch_stages": _stage_medians(batch),
+        "date": time.strftime("%Y-%m-%d %H:%M"), "load": os.getloadavg()[0],
+        "cores": os.cpu_count(),
+    }
+    ratio = None
+    if figures["grader_overhead_s_median_ep5"] and figures["batch_overhead_s_median"]:
+        ratio = figures["grader_overhead_s_median_ep5"] / figures["batch_overhead_s_median"]
+    figures["overhead_ratio_ep5"] = round(ratio, 2) if ratio else None
+    with open(os.path.join(output, "bench_grade.json"), "w") as out:
+        json.dump(figures, out, indent=1)
+    print("[bench_grade] %(students)d students, %(runs)d runs (%(graded_runs)d ran the world) "
+          "in %(wall_s).0f s with %(workers)s workers: %(runs_per_minute).1f runs a minute"
+          % dict(figures, workers=args.workers or os.cpu_count()))
+    print("[bench_grade] overhead a run [s wall, median]: grader %s (ep5 %s), batch runner %s "
+          "on the same controller; ratio %s (target <= 1.10)"
+          % (figures["grader_overhead_s_median"], figures["grader_overhead_s_median_ep5"],
+             figures["batch_overhead_s_median"], figures["overhead_ratio_ep5"]))
+    print("[bench_grade] stages [s, median]: grader ep5 %s; batch %s"
+          % (figures["grader_stages_ep5"], figures["batch_stages"]))
+    return figures
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="bench_grade", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--students", type=int, default=30)
+    parser.add_argument("--workers", type=int, default=None, help="default: cores")
+    parser.add_argument("--output", default=os.path.join(ROOT, "output"))
+    args = parser.parse_args(argv)
+    try:
+        bench(args)
+    except KeyboardInterrupt:
+        print("[bench_grade] interrupted", file=sys.stderr)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
