@@ -12,8 +12,9 @@ Overhead [s wall] is a run's wall time less the part in which the world ran (the
 overhead_s, see m2wr_tools.rig: resetting the world, starting and stopping the controller,
 measuring) plus, for the grader, what it adds around the run (grader_s: the student's files
 copied in and out, the rules' last look, the end by PID). Medians: a worker's first run also
-starts its simulator. For the comparison both sides grade the same 60 s obstacle avoider from (0, 8) in
-world02 with the same number of workers; the batch runner through scripts/evaluate.sh.
+starts its simulator. For the comparison both sides run the same 60 s obstacle avoider in world02 with the same
+number of workers and one seed; the batch runner through scripts/evaluate.sh, from as many
+random free starts as the class had runs of it.
 
     scripts/bench.sh --grade [--students 30] [--workers 2] [--output output/]
 
@@ -83,6 +84,9 @@ def make_class(folder, students):
         for script, source in SCRIPTS.items():
             with open(source) as text:
                 body = text.read()
+            # a Gazebo Noetic user's copy: m2wr turns the other way there, so the series'
+            # learners negate angular.z (the simulator's default, as the grader runs it)
+            body = body.replace('get_param("~turn_sign", 1)', 'get_param("~turn_sign", -1)')
             # episodes 6 and 7 run them on their own: switched on from the start
             if script == "go_to_point.py":
                 body = body.replace('get_param("~active", False)', 'get_param("~active", True)')
@@ -144,9 +148,11 @@ def bench(args):
     ep5 = [r for r in graded if r.get("task") == "ep5_avoid"]
     # the batch runner on the same controller, as many runs as the class had of ep5
     evaluate_out = os.path.join(output, "bench_grade_evaluate")
+    # one seed (a new seed relaunches the simulator, as the class's runs never do), starts
+    # drawn at random in the free space: as many distinct runs as the class had of ep5
     _run([sys.executable, "-m", "m2wr_tools.evaluate", "--controller", TUTORIAL,
           "--task", "wander", "--world", "world02", "--duration", str(DURATION),
-          "--seeds"] + [str(i) for i in range(max(1, len(ep5)))] + ["--start", "0", "8", "0",
+          "--seeds", "0", "--random", str(max(2, len(ep5))), "--pose-seed", "0",
           "--output", evaluate_out, "--fresh", "--no-progress"] + workers,
          "the batch runner on the same controller")
     with open(os.path.join(evaluate_out, "results.json")) as source:

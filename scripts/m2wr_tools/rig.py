@@ -58,6 +58,7 @@ from .gazebo import Services, model_poses
 from .names import (BASE_FRAME, COMMAND_TOPIC, CONTACTS_TOPIC, ODOM_TOPIC, PAUSE_SERVICE,
                     RESET_SIMULATION_SERVICE, ROBOT, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC,
                     SIMULATOR_NODE, TF_TOPIC, UNPAUSE_SERVICE)
+from .param_snapshot import ParamSnapshot
 from .scenarios import Scenario
 from .session import Session, SessionError, python_logging_config
 
@@ -104,6 +105,7 @@ class Rig:
         self.scenes = {}              # world -> scene.Scene (offline geometry)
         self.zygote = None            # zygote.Zygote of this session (warm Python controllers)
         self.services = Services()    # the simulator's services, connections kept between runs
+        self.params = ParamSnapshot()  # the parameters as a run found them, put back after it
         self._executables = {}        # (package, name) -> path, for rosrun command lines
         self.worker = "%s:%d" % (socket.gethostname(), os.getpid())
 
@@ -231,6 +233,11 @@ class Rig:
         finally:
             stopping = time.monotonic()
             record["controller_exit"] = self._stop_controller(record.get("controller_exit"))
+            try:
+                record["params_put_back"] = self.params.restore()
+            except Exception as err:           # the master is gone: relaunched next run
+                record["params_put_back"] = "failed: %s" % err
+                self.key = None
             if "distance_m" in record:          # measured: the controller's lines are all out
                 record["cases_s"] = _case_shares(log_path, scenario.duration)
             if isinstance(record.get("stages"), dict):
@@ -297,6 +304,7 @@ class Rig:
             meter.mark(name)
         self.services.empty(PAUSE_SERVICE)
         self.services.empty(RESET_SIMULATION_SERVICE)
+        self.params.take()                     # put back after the run (param_snapshot.py)
         self.services.set_model_pose(ROBOT, scenario.x, scenario.y, SPAWN_Z, scenario.yaw)
         task = scenario.task
         if task.kind == "goal":
