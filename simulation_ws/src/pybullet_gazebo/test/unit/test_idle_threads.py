@@ -208,3 +208,18 @@ def test_the_run_queue_counts_a_running_child(child):
 def test_the_kernel_backlog_columns_follow_the_kernel(columns, backlog):
     from pybullet_gazebo.ros.idle_threads import _backlog_columns
     assert _backlog_columns(columns) == backlog
+
+
+def test_the_quick_look_reads_threads_it_has_not_seen_before(child):
+    """The quick look's check of the thread states must read every thread, also on a watch
+    that has not looked at the process before (it once read only known threads: none)."""
+    from pybullet_gazebo.ros.idle_threads import ProcessThreads
+    worker = child(WORKER, "0.5")
+    worker.stdin.write("1\n")
+    worker.stdin.flush()
+    time.sleep(0.05)                               # it computes for 0.5 s now
+    threads = ProcessThreads(worker.pid)
+    try:
+        assert threads.asleep_now() is not None
+    finally:
+        threads.close()

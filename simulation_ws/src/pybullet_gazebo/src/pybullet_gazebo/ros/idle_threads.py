@@ -179,15 +179,23 @@ class ProcessThreads:
 
     def asleep_now(self):
         """After the quick look (no busy loop known): a tid of a thread running or waiting
-        for a CPU (or being woken), None if all sleep, False when the process is gone."""
-        if not os.path.isdir(self.task_dir):
+        for a CPU (or being woken), None if all sleep, False when the process is gone. Every
+        thread is read, those new since the last look too."""
+        try:
+            tids = [int(name) for name in os.listdir(self.task_dir)]
+        except OSError:
             return False
-        for tid, thread in self.threads.items():
+        for tid in tids:
+            thread = self.threads.get(tid)
             try:
+                if thread is None:
+                    thread = self.threads[tid] = self._open(tid)
                 if state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES:
                     return tid
             except (OSError, ValueError, IndexError):
                 continue                                   # the thread ended meanwhile
+        if len(self.threads) > len(tids):
+            self._forget_ended(set(tids))
         return None
 
     def moved_since_look(self):
