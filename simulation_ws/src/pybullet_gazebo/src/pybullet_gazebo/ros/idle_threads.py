@@ -39,8 +39,9 @@ at that moment no thread of any process was running or waiting for a CPU, and no
 the backlog just read, so nothing was being handed on. Only the simulator's own readers are
 still looked at (one asleep outside a socket wait may hold a message, waiting for the GIL that
 the simulator's loop holds). Not beside a known busy loop, whose process's sleeping threads
-may be waiting for its GIL (the whole looks handle those). When anything else runs (a controller at work, a busy loop, other
-jobs on a shared machine) the watch takes the two looks above. (A thread in an uninterruptible
+may be waiting for its GIL (the whole looks handle those). When anything else runs (a
+controller at work, a busy loop, other jobs on a shared machine) the watch takes the two
+looks above. (A thread in an uninterruptible
 wait, D, is not counted as runnable: the quick look misses a controller blocked on its disk.)
 
 Busy loops. A thread that never sleeps (the series' go_to_point spins in
@@ -60,8 +61,9 @@ since the last message went out (its count of runs in /proc/.../schedstat), or i
 a socket wait (back to reading: done), or it has not run while the busy loop ran for
 GIL_WAIT of CPU (a thread waiting for the GIL wakes every 5 ms, the switch interval, to ask
 for it, or waits for the busy loop to release the GIL's mutex, which takes the busy loop's
-running: on a loaded machine, where the busy loop waits for a CPU, this takes longer). A busy loop thus costs lockstep about one switch interval of wall time per message
-its process gets, as it delays that process's callbacks at real time.
+running: on a loaded machine, where the busy loop waits for a CPU, this takes longer). A
+busy loop thus costs lockstep about one switch interval of wall time per message its process
+gets, as it delays that process's callbacks at real time.
 
 Linux only (/proc); threads of processes on other machines cannot be watched.
 """
@@ -97,8 +99,8 @@ def in_socket_wait(syscall):
 
 class _Thread:
     """What the watch remembers of one thread."""
-    __slots__ = ("fd", "sched_fd", "runs", "busy_since", "cpu_since", "spinning", "runs_at_send", "runs_seen",
-                 "runs_seen_at")
+    __slots__ = ("fd", "sched_fd", "runs", "busy_since", "cpu_since", "spinning",
+                 "runs_at_send", "runs_seen", "runs_seen_at")
 
     def __init__(self, fd, sched_fd):
         self.fd = fd                # its /proc stat, for its state
@@ -123,20 +125,9 @@ class ProcessThreads:
     def busy_thread(self, now, round_start):
         """A tid that is running and not a busy loop (None: the process is idle), or False
         when the process is gone. `round_start`: when the present wait began."""
-        try:
-            tids = [int(name) for name in os.listdir(self.task_dir)]
-        except OSError:
+        running = self._states(note_runs=True)
+        if running is None:
             return False
-        running = {}
-        for tid in tids:
-            thread = self.threads.get(tid)
-            try:
-                if thread is None:
-                    thread = self.threads[tid] = self._open(tid)
-                thread.runs = os.pread(thread.sched_fd, 128, 0)       # before its state
-                running[tid] = state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES
-            except (OSError, ValueError, IndexError):
-                continue                                   # the thread ended meanwhile
         threads = self.threads
         others_run = any(run for tid, run in running.items() if not threads[tid].spinning)
         spinners = [tid for tid, t in threads.items() if t.spinning]
@@ -161,8 +152,6 @@ class ProcessThreads:
                 continue
             if busy is None:
                 busy = tid
-        if len(threads) > len(tids):
-            self._forget_ended(set(tids))
         return busy
 
     def spinners(self):
@@ -179,24 +168,34 @@ class ProcessThreads:
 
     def asleep_now(self):
         """After the quick look (no busy loop known): a tid of a thread running or waiting
-        for a CPU (or being woken), None if all sleep, False when the process is gone. Every
-        thread is read, those new since the last look too."""
+        for a CPU (or being woken), None if all sleep, False when the process is gone."""
+        running = self._states(note_runs=False)
+        if running is None:
+            return False
+        return next((tid for tid, run in running.items() if run), None)
+
+    def _states(self, note_runs):
+        """{tid: running or waiting for a CPU} of every thread now, those new since the last
+        look too (ended ones forgotten), or None when the process is gone. `note_runs`: keep
+        each thread's schedstat, read before its state, for moved_since_look."""
         try:
             tids = [int(name) for name in os.listdir(self.task_dir)]
         except OSError:
-            return False
+            return None
+        running = {}
         for tid in tids:
             thread = self.threads.get(tid)
             try:
                 if thread is None:
                     thread = self.threads[tid] = self._open(tid)
-                if state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES:
-                    return tid
+                if note_runs:
+                    thread.runs = os.pread(thread.sched_fd, 128, 0)
+                running[tid] = state_of(os.pread(thread.fd, 512, 0)) in _BUSY_STATES
             except (OSError, ValueError, IndexError):
                 continue                                   # the thread ended meanwhile
         if len(self.threads) > len(tids):
             self._forget_ended(set(tids))
-        return None
+        return running
 
     def moved_since_look(self):
         """After a look that found this process idle: a tid that is running or has run since
@@ -293,6 +292,7 @@ class RunQueue:
     """The number of runnable tasks on the machine now (running or waiting for a CPU)."""
 
     def __init__(self):
+        self._fd = None
         try:
             self._fd = os.open("/proc/loadavg", os.O_RDONLY)
             self.runnable()
@@ -306,7 +306,7 @@ class RunQueue:
         return int(os.pread(self._fd, 128, 0).split()[3].split(b"/")[0])
 
     def close(self):
-        if getattr(self, "_fd", None) is not None:
+        if self._fd is not None:
             os.close(self._fd)
         self._fd = None
 
@@ -370,7 +370,9 @@ class IdleWatch:
 
     def busy(self, new_round=True):
         """(pid, tid) of a thread still at work, ("self", None) for the simulator's own
-        receivers, ("kernel", n) for n packets not yet delivered, or None when all are idle. Processes that ended are dropped.
+        receivers, ("kernel", n) for n packets not yet delivered, ("machine", None) when a
+        quick look was undone by another task, or None when all are idle. Processes that
+        ended are dropped.
         `new_round`: this look starts a wait (see the module docstring on busy loops)."""
         now = time.monotonic()
         if new_round:
@@ -380,15 +382,23 @@ class IdleWatch:
             return "kernel", packets
         if self.run_queue.runnable() == 1 and not self._spinning():   # the quick look
             return self._confirm_quick_look()
+        busy = self._first_busy(lambda p: p.busy_thread(now, self._round_start))
+        if busy is not None:
+            return busy
+        if self.own_busy():
+            return "self", None
+        return self._second_look()
+
+    def _first_busy(self, look):
+        """(pid, tid) of the first process in which `look(process)` finds a thread at work,
+        or None; processes it finds gone (False) are dropped."""
         for pid, process in list(self._processes.items()):
-            tid = process.busy_thread(now, self._round_start)
+            tid = look(process)
             if tid is False:
                 self._processes.pop(pid).close()
             elif tid is not None:
                 return pid, tid
-        if self.own_busy():
-            return "self", None
-        return self._second_look()
+        return None
 
     def _spinning(self):
         """Whether a busy loop is known (its process's sleeping threads may be waiting for
@@ -396,12 +406,9 @@ class IdleWatch:
         return any(t.spinning for p in self._processes.values() for t in p.threads.values())
 
     def _confirm_quick_look(self):
-        for pid, process in list(self._processes.items()):
-            tid = process.asleep_now()
-            if tid is False:
-                self._processes.pop(pid).close()
-            elif tid is not None:
-                return pid, tid
+        busy = self._first_busy(ProcessThreads.asleep_now)
+        if busy is not None:
+            return busy
         if self.own_busy():
             return "self", None
         if self.run_queue.runnable() != 1:
