@@ -10,7 +10,8 @@ learner would see: reached or not, sim time to the goal, contact events, where i
 A run: the world paused (world launch defaults but headless, legacy_mode:=true: the
 series' programs turn as REP 103 says, contacts:=true), m2wr spawned at the start, the
 program's launch file started and connected; then, still paused, the behaviour is switched
-on (go_to_point, follow_wall; bug2 switches its own), the clock of the run starts (sim time
+on (go_to_point, follow_wall; bug2 switches its own, and puts the robot at its start with
+/gazebo/set_model_state, which the simulator's call log must show first), the clock of the run starts (sim time
 now), physics unpauses, and /odom is watched until the robot is within `tolerance` of the
 goal or `duration` of sim time has passed. The same steps in both modes, so that the only
 difference is the pacing: lockstep (real_time_factor 0) or real time (real_time_factor 1).
@@ -33,17 +34,22 @@ from .session import Session, SessionError
 # program -> (launch file in motion_plan/test/series_style, the switch service the run calls
 # or None when the program switches its own behaviours, its nodes' connections to the
 # simulator [(node, topic)] that must be up before physics starts: a cmd_vel published
-# before the simulator has connected to its publisher is lost, in Gazebo too)
+# before the simulator has connected to its publisher is lost, in Gazebo too, and the
+# simulator's service its program calls as it starts, which must have been called before
+# physics starts, or None: bug 2 puts the robot at its start with set_model_state, and a
+# run that unpaused first would start wherever the robot was by then)
 PROGRAMS = {
     "go_to_point": ("series_go_to_point.launch", "/go_to_point_switch",
-                    [("/go_to_point", "/odom"), ("/go_to_point", "/cmd_vel")]),
+                    [("/go_to_point", "/odom"), ("/go_to_point", "/cmd_vel")], None),
     "follow_wall": ("series_follow_wall.launch", "/wall_follower_switch",
-                    [("/follow_wall", "/m2wr/laser/scan"), ("/follow_wall", "/cmd_vel")]),
+                    [("/follow_wall", "/m2wr/laser/scan"), ("/follow_wall", "/cmd_vel")], None),
     "bug2": ("series_bug2.launch", None,
              [("/go_to_point", "/odom"), ("/go_to_point", "/cmd_vel"),
               ("/follow_wall", "/m2wr/laser/scan"), ("/follow_wall", "/cmd_vel"),
-              ("/bug2", "/odom"), ("/bug2", "/m2wr/laser/scan")]),
+              ("/bug2", "/odom"), ("/bug2", "/m2wr/laser/scan")],
+             ("/bug2", "/gazebo/set_model_state")),
 }
+CALL_LOG_PARAM = "/gazebo/call_log"     # pybullet_gazebo.ros.call_log.PARAM
 MODES = ("lockstep", "real-time")
 
 
@@ -86,6 +92,7 @@ class Watcher:
             self.distance = 0.0             # [m] driven
             self.touching = set()
             self.contact_events = 0
+            self.touches = []               # [(t [s sim], x, y, what)]: each contact's start
             self.sim_time = None
 
     def _on_clock(self, msg):
@@ -105,7 +112,11 @@ class Watcher:
     def _on_contacts(self, msg):
         touching = {(s.collision1_name, s.collision2_name) for s in msg.states}
         with self.lock:
-            self.contact_events += len(touching - self.touching)
+            started = touching - self.touching
+            self.contact_events += len(started)
+            where = self.pose[1:] if self.pose else (float("nan"), float("nan"))
+            self.touches.extend((msg.header.stamp.to_sec(), where[0], where[1], " & ".join(pair))
+                                for pair in sorted(started))
             self.touching = touching
 
 
@@ -115,6 +126,16 @@ def sim_time_now():
     from gazebo_msgs.srv import GetWorldProperties
     rospy.wait_for_service(WORLD_PROPERTIES_SERVICE, timeout=10.0)
     return rospy.ServiceProxy(WORLD_PROPERTIES_SERVICE, GetWorldProperties)().sim_time
+
+
+def called(call_log, node, service):
+    """Whether the simulator's call log has a request from `node` to `service`."""
+    try:
+        with open(call_log) as lines:
+            calls = [json.loads(line) for line in lines if line.strip()]
+    except (OSError, ValueError):
+        return False
+    return any(c.get("caller") == node and c.get("service") == service for c in calls)
 
 
 def wait_until(condition, timeout, what, check=lambda: None):
@@ -131,8 +152,12 @@ def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
     """One run (the session's master up, rospy initialised); returns its record."""
     import rospy
     from std_srvs.srv import SetBool
-    launch_file, switch, connections = PROGRAMS[run.program]
+    launch_file, switch, connections, start_call = PROGRAMS[run.program]
     lockstep = run.mode == "lockstep"
+    call_log = os.path.join(session.log_dir, "gazebo_calls.jsonl")
+    if os.path.exists(call_log):
+        os.remove(call_log)
+    session.master().setParam("/series_runs", CALL_LOG_PARAM, call_log)
     session.launch_world(run.world, real_time_factor=0.0 if lockstep else 1.0,
                          lockstep=lockstep, paused=True, pub_clock_frequency=run.clock_hz,
                          contacts=True, extra=("legacy_mode:=true",))
@@ -152,6 +177,10 @@ def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
         for node, topic in connections:
             wait_until(lambda: session.connected(node, topic, "/gazebo"), 60.0,
                        "%s did not connect to the simulator on %s" % (node, topic),
+                       lambda: session.check_running(["world", "controller"]))
+        if start_call is not None:
+            wait_until(lambda: called(call_log, *start_call), 60.0,
+                       "%s did not call %s" % start_call,
                        lambda: session.check_running(["world", "controller"]))
         watcher.reset(run.goal, run.tolerance)
         if switch is not None:
@@ -173,6 +202,7 @@ def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
                 "reached": watcher.reached_at is not None,
                 "time_to_goal_s": watcher.reached_at - t0 if watcher.reached_at else None,
                 "contact_events": watcher.contact_events,
+                "touches": [[t - t0, x, y, what] for t, x, y, what in watcher.touches],
                 "distance_m": watcher.distance,
                 "end": list(watcher.reached_pose) if watcher.reached_pose else
                 [pose[1], pose[2]] if pose else None,
