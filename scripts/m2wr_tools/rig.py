@@ -399,19 +399,28 @@ class Rig:
         """The run's controller as the session's child "controller": forked from the warm
         zygote when it is a Python script of this interpreter (see m2wr_tools.zygote), else
         a plain subprocess (roslaunch, binaries, other interpreters)."""
-        from . import zygote
         session = self.session
-        if warm and zygote.warm_script(argv, session.env.get("PATH", os.defpath)):
+        return self._start_warm_or_plain(
+            argv, log_path, warm, session.env, lambda: session.start_controller(
+                argv, log_name=os.path.relpath(log_path[:-4], session.log_dir)))
+
+    def _start_warm_or_plain(self, argv, log_path, warm, env, plain, **confine):
+        """The session's child "controller": forked from the worker's zygote when `warm` and
+        `argv` is a Python script of this interpreter, with `confine` (zygote.Zygote.start's
+        cwd, user, group, rlimits) set in the child before the script's first line; else,
+        or when the zygote fails (a new one comes next run), `plain()`'s child."""
+        from . import zygote
+        child = None
+        if warm and zygote.warm_script(argv, env.get("PATH", os.defpath)):
             try:
-                child = self._zygote().start("controller", argv, session.env, log_path)
+                child = self._zygote().start("controller", argv, env, log_path, **confine)
             except RuntimeError:
                 self.zygote.close()
-                self.zygote = None               # a plain start below; a new zygote next run
-            else:
-                session.children["controller"] = child
-                return child
-        return session.start_controller(argv, log_name=os.path.relpath(log_path[:-4],
-                                                                       session.log_dir))
+                self.zygote = None
+        if child is None:
+            child = plain()
+        self.session.children["controller"] = child
+        return child
 
     def _zygote(self):
         """The worker's warm zygote (m2wr_tools.zygote), started anew if it is not running."""

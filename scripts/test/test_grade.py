@@ -154,6 +154,14 @@ def test_rules_allow_the_bug_programs_start_and_fail_everything_else():
     assert rules.graph_findings(state, ignore=("/m2wr_batch", "/gazebo")) == {
         ("published on", "/gazebo/set_model_state", "/cheat"),
         ("subscribed to", "/gazebo/model_states", "/peek")}
+    logged = [to_start, {"topic": "/gazebo/model_states", "subscriber": "/peek", "sim_time": 3.0},
+              {"topic": "/gazebo/model_states", "subscriber": "/m2wr_batch", "sim_time": 0.0},
+              {"topic": "/gazebo/set_model_state", "publisher": "/cheat", "sim_time": 4.5}]
+    assert rules.service_findings(logged, (), start) == rules.service_findings(
+        [to_start], (), start)                      # the topic entries are not service calls
+    assert rules.logged_topic_users(logged, ignore=("/m2wr_batch",)) == [
+        ("subscribed to", "/gazebo/model_states", "/peek", 3.0),
+        ("published on", "/gazebo/set_model_state", "/cheat", 4.5)]
 
 
 class _Sub:

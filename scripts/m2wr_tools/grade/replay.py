@@ -1,7 +1,8 @@
 """`grade.sh --replay STUDENT TASK RUN`: one graded run again, on this machine, as it was
 graded (the same scenario: world, start, seed, duration, command, the student's staged
 packages, rules and limits; lockstep), drawn to <output>/replay/<run_id>.png, with its
-metrics printed beside the graded record's. --gui opens the simulator's window and runs at
+metrics printed beside the graded record's and its record in <output>/replay/<run_id>.json;
+the last line says whether every measure is the graded one to the last digit. --gui opens the simulator's window and runs at
 real time (lockstep still: the same physics)."""
 import json
 import os
@@ -66,12 +67,29 @@ def replay(output, student, task, index, gui=False, say=print):
         for signum, handler in old.items():
             import signal
             signal.signal(signum, handler)
+    path = os.path.join(options.output, "%s.json" % scenario.run_id)
+    with open(path, "w") as out:
+        json.dump(record, out, indent=1, sort_keys=True)
     print("%-16s %-28s %s" % ("", "graded", "replayed"))
     for key, label, unit in COMPARED:
         print("%-16s %-28s %s" % (label, _text(graded.get(key), unit), _text(record.get(key),
                                                                              unit)))
-    say("picture %s" % record.get("picture"))
+    say("picture %s, record %s" % (record.get("picture"), path))
+    differ = differences(graded, record)
+    say("the replay differs from the graded run in: %s" % ", ".join(differ) if differ else
+        "the replay is the graded run: every measure equal to the last digit")
     return 0
+
+
+def differences(graded, replayed):
+    """The measures (COMPARED, and the rules' findings) in which two records differ. Of a
+    run the rules ended while the world ran, only the verdict: its processes were stopped
+    when the grader's look (every 0.1 s of wall time) found what they did, and how far the
+    robot got by then is the machine's timing, not the program's."""
+    keys = [key for key, _, _ in COMPARED] + ["findings"]
+    if str(graded.get("reason", "")).startswith("rules:"):
+        keys = ["success", "reason", "findings"]
+    return [key for key in keys if graded.get(key) != replayed.get(key)]
 
 
 def _text(value, unit):

@@ -6,7 +6,8 @@ use of the simulator's own interface (Gazebo's `/gazebo/*` services and topics) 
   - a call of a /gazebo/* service (the simulator logs each request's caller id and sim time:
     pybullet_gazebo.ros.call_log),
   - a subscription to a /gazebo/* topic (ground truth: model_states, link_states, contacts)
-    or a publication on one (set_model_state as a topic), as the master lists them.
+    or a publication on one (set_model_state as a topic): the simulator logs each node that
+    connects to one of its own /gazebo/* topics, and the master lists the rest.
 Always allowed (a note, not a failure): spawning a model named m2wr, which the simulator
 refuses because m2wr is already there (the series' launch files may include spawn.launch).
 A task adds permissions with `allow:` (PERMISSIONS). A finding that nothing allows fails the
@@ -31,7 +32,7 @@ def service_findings(calls, allow, start, ignore=()):
     nodes other than `ignore`; `start` is the run's (x, y, yaw)."""
     found = []
     for call in calls:
-        if call.get("caller") in ignore:
+        if "service" not in call or call.get("caller") in ignore:
             continue
         finding = {"what": "called %s" % call["service"], "node": call.get("caller", "?"),
                    "sim_time": call.get("sim_time")}
@@ -67,6 +68,17 @@ def graph_findings(system_state, ignore=()):
         for topic, nodes in listing:
             if topic.startswith(GAZEBO):
                 found.update((kind, topic, n) for n in nodes if n not in ignore)
+    return found
+
+
+def logged_topic_users(entries, ignore=()):
+    """[(kind, topic, node, sim_time)] of the call log's topic entries (a node that
+    connected to one of the simulator's /gazebo/* topics) by nodes other than `ignore`."""
+    found = []
+    for entry in entries:
+        for role, kind in (("subscriber", "subscribed to"), ("publisher", "published on")):
+            if "topic" in entry and role in entry and entry[role] not in ignore:
+                found.append((kind, entry["topic"], entry[role], entry.get("sim_time")))
     return found
 
 

@@ -28,9 +28,8 @@ import time
 import xmlrpc.client
 from typing import Tuple
 
-from .. import processes, zygote
-from ..metrics import Task
-from ..rig import NODE, Rig, RunOptions, run_on
+from .. import processes
+from ..rig import NODE, Rig, RunFailed, RunOptions, run_on
 from ..scenarios import Scenario
 from . import classroom, rules, sandbox
 from .spec import Limits
@@ -146,21 +145,12 @@ class GradeRig(Rig):
         isolating = sandbox.isolating()
         user = self.slot.uid if isolating else None
         group = self.slot.gid if isolating else None
-        child = None
-        if warm and zygote.warm_script(argv, env.get("PATH", os.defpath)):
-            try:
-                child = self._zygote().start("controller", argv, env, log_path,
-                                             cwd=run.folder, user=user, group=group,
-                                             rlimits=sandbox.rlimits(run.options.limits,
-                                                                     isolating))
-            except RuntimeError:
-                self.zygote.close()
-                self.zygote = None          # a plain start below; a new zygote next run
-        if child is None:
-            child = processes.Child("controller", sandbox.limited(argv, run.options.limits,
-                                                                    isolating), env,
-                                    log_path, cwd=run.folder, user=user, group=group)
-        self.session.children["controller"] = child
+        child = self._start_warm_or_plain(
+            argv, log_path, warm, env, lambda: processes.Child(
+                "controller", sandbox.limited(argv, run.options.limits, isolating), env,
+                log_path, cwd=run.folder, user=user, group=group),
+            cwd=run.folder, user=user, group=group,
+            rlimits=sandbox.rlimits(run.options.limits, isolating))
         run.watch(self, child)
         return child
 
@@ -169,14 +159,19 @@ class GradeRig(Rig):
         paused: what the program subscribed to as it started is found at the start's sim
         time on every grading (the watchdog's looks come at wall times the machine picks;
         seen first by one of them, a warm-started program's subscription was dated 0.00 s
-        in one grading and 0.01 s in the next, and grades.csv differed)."""
+        in one grading and 0.01 s in the next, and grades.csv differed). A program the
+        rules stopped before the world ran ends its run here, whichever look found it: the
+        watchdog's while it started (its processes stopped) or this one."""
         super()._wait_for_controller(controller, timeout, log_path, **kwargs)
         if self.current is not None:
             self.current.look(self)
+            if self.current.broken:
+                raise RunFailed(rules.verdict(self.current.findings))
 
     def _stop_controller(self, known_exit):
         if self.current is not None and self.current.watchdog is not None:
-            self.current.watchdog.stop()           # its last look sees the graph as it ends
+            self.current.watchdog.stop()
+            self.current.look(self)                # the graph as it ends, nodes still up
         return super()._stop_controller(known_exit)
 
     def close(self):
@@ -226,27 +221,36 @@ class _Run:
     def watch(self, rig, controller):
         self.controller = controller
         self.watchdog = sandbox.Watchdog(lambda: self.pids(rig), self.options.memory_mib,
-                                         lambda: self.kill(rig), also=lambda: self.look(rig))
+                                         lambda: self.kill(rig),
+                                         also=lambda: self.look(rig, graph=False))
         self.watchdog.start()
 
-    def look(self, rig):
-        """New findings from the simulator's call log and the master's graph; a finding no
-        rule allows ends the run's processes at once (the run has failed). From the
-        watchdog's thread and from the rig's (before the world runs): one look at a time."""
+    def look(self, rig, graph=True):
+        """New findings from the simulator's call log (service calls, users of its /gazebo/*
+        topics) and, with `graph`, the master's graph (subscriptions to /gazebo/* topics
+        nobody serves, a node that registered but never connected); a finding no rule
+        allows ends the run's processes at once (the run has failed). From the watchdog's
+        thread (the log alone: a look at the master wakes it, and lockstep waits for the
+        master) and from the rig's, before the world runs and as the controller stops: one
+        look at a time."""
         with self._looking:
-            self._look(rig)
+            self._look(rig, graph)
 
-    def _look(self, rig):
+    def _look(self, rig, graph):
         sim_time = (rig.recorder.sim_time if rig.recorder is not None else None) or 0.0
         calls, self.calls_from = _read_calls(rig._call_log(), self.calls_from)
         new = rules.service_findings(calls, self.scenario.allow,
                                      (self.scenario.x, self.scenario.y), ignore=(NODE,))
-        code, _, state = self.master.getSystemState(NODE)
-        if code == 1:
-            for kind, topic, node in rules.graph_findings(state, ignore=(NODE, SIMULATOR)):
-                if (kind, topic, node) not in self.seen:
-                    self.seen.add((kind, topic, node))
-                    new.append(rules.topic_finding(kind, topic, node, sim_time))
+        users = rules.logged_topic_users(calls, ignore=(NODE, SIMULATOR))
+        if graph:
+            code, _, state = self.master.getSystemState(NODE)
+            if code == 1:
+                users += [(kind, topic, node, sim_time) for kind, topic, node in
+                          sorted(rules.graph_findings(state, ignore=(NODE, SIMULATOR)))]
+        for kind, topic, node, when in users:
+            if (kind, topic, node) not in self.seen:
+                self.seen.add((kind, topic, node))
+                new.append(rules.topic_finding(kind, topic, node, when))
         self.findings += new
         if not self.broken and rules.verdict(new):
             self.broken = True

@@ -109,3 +109,11 @@ def test_the_fixture_class_gets_the_grades_a_teacher_expects(tmp_path):
     assert status == 0, text
     assert (tmp_path / "out" / "grades.csv").read_bytes() == \
         (tmp_path / "again" / "grades.csv").read_bytes()
+    # an appeal: dan's goal run replayed on a fresh simulator is the graded run, the rule
+    # finding (what, who, when) included
+    replayed = subprocess.run(["bash", GRADE, "--replay", "dan", "goal", "0", "--output",
+                               str(tmp_path / "out")], stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, text=True, timeout=120)
+    assert replayed.returncode == 0, replayed.stdout
+    assert replayed.stdout.rstrip().endswith(
+        "the replay is the graded run: every measure equal to the last digit"), replayed.stdout
