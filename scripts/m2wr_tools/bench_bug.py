@@ -23,9 +23,10 @@ import threading
 import time
 
 from . import processes
-from .processes import Interrupted, raise_on_signals
+from .processes import raise_on_signals
 from .names import CONTACTS_TOPIC, ROSOUT_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH
 from .session import Session, SessionError
+from .tool_exit import exit_status
 
 # world: (legacy_mode, the controllers' turn_sign, goal), as bug2_world02/03.test run them
 RUNS = {
@@ -210,9 +211,10 @@ def main(argv=None):
     session = Session(os.path.join(out, "logs", "bench_bug"), name="m2wr_bench_bug")
 
     raise_on_signals()
-    runs, status = [], 0
+    runs = []
     load = "%.2f %.2f %.2f" % os.getloadavg()
-    try:
+
+    def bench_runs():
         session.start_master()
         os.environ.update(ROS_MASTER_URI=session.master_uri, ROS_HOSTNAME="localhost")
         import rospy
@@ -220,14 +222,10 @@ def main(argv=None):
         rospy.init_node("m2wr_bench_bug", disable_signals=True)
         for world in args.worlds:
             runs.append(run_world(session, world, args.sim_limit, args.wall_limit))
-            if not runs[-1]["reached"]:
-                status = 1
-    except SessionError as err:
-        sys.stderr.write("bench_bug: %s\n" % err)
-        status = 1
-    except Interrupted as err:
-        sys.stderr.write("bench_bug: interrupted (%s); stopping everything\n" % err)
-        status = 130
+        return 0 if all(r["reached"] for r in runs) else 1
+    try:
+        status = exit_status("bench_bug", bench_runs, interrupted="stopping everything",
+                             known=(SessionError,))
     finally:
         session.shut_down("bench_bug")
     load = "%s before, %.2f %.2f %.2f after" % ((load,) + os.getloadavg())

@@ -24,13 +24,14 @@ import sys
 import time
 
 from . import processes, summary
-from .processes import Interrupted, raise_on_signals
+from .processes import raise_on_signals
 from .names import (COMMAND_TOPIC, CONTROLLER_NODE, DEFAULT_START, DEFAULT_WORLD, ODOM_TOPIC,
                     PAUSE_SERVICE, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC, SIMULATOR_NODE,
                     UNPAUSE_SERVICE)
 from .paths import ROOT
 from .scene import SCAN_HEIGHT
 from .session import Session, SessionError
+from .tool_exit import exit_status
 
 BAG_TOPICS = (SCAN_TOPIC, ODOM_TOPIC, COMMAND_TOPIC)
 PROGRESS_PERIOD = 2.0       # [s] wall
@@ -224,18 +225,13 @@ def main(argv=None):
 
     raise_on_signals()
 
-    status, data = 0, None
-    try:
-        data = run(args, session, paths)
-    except SessionError as err:
-        sys.stderr.write("demo: %s\n" % err)
-        status = 1
-    except Interrupted as err:
-        sys.stderr.write("demo: interrupted (%s); stopping everything\n" % err)
-        status = 130
-    except Exception as err:     # a ROS call failed: say which, then clean up
-        sys.stderr.write("demo: %s: %s\n" % (type(err).__name__, err))
-        status = 1
+    ran = []
+
+    def demo_run():
+        ran.append(run(args, session, paths))
+    try:            # catch_all: a ROS call failed: say which, then clean up
+        status = exit_status("demo", demo_run, interrupted="stopping everything",
+                             known=(SessionError,), catch_all=True)
     finally:
         say("stopping everything it started")
         session.shut_down("demo")
@@ -250,7 +246,7 @@ def main(argv=None):
     if status != 0:
         return status
     try:
-        result = analyse(args, data, paths)
+        result = analyse(args, ran[0], paths)
     except Exception as err:
         sys.stderr.write("demo: the analysis of the run failed: %s: %s\n" % (type(err).__name__, err))
         return 1

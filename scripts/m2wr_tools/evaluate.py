@@ -54,6 +54,7 @@ from .names import DEFAULT_START, DEFAULT_WORLD, TUTORIAL_CONTROLLER
 from .paths import ROOT
 from .rig import RunOptions
 from .scenarios import FREE_MARGIN, check_starts, combinations, grid_starts, random_starts
+from .tool_exit import BadInput, exit_status
 
 
 def parse_args(argv):
@@ -431,40 +432,33 @@ def _memory(records):
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
     args.output = os.path.abspath(args.output)
-    from .batch import Interrupted, run_batch
+    return exit_status("evaluate", lambda: evaluate(args), interrupted=(
+        "every process of the batch stopped; the runs done are in %s (run the same command "
+        "again to resume)" % os.path.join(args.output, "results.json")))
+
+
+def evaluate(args):
+    from .batch import run_batch
+    os.makedirs(args.output, exist_ok=True)
+    if args.bench:
+        return bench(args)
+    if args.bench_memory:
+        return bench_memory(args)
+    outlines_of = _Outlines()
     try:
-        os.makedirs(args.output, exist_ok=True)
-        if args.bench:
-            return bench(args)
-        if args.bench_memory:
-            return bench_memory(args)
-        outlines_of = _Outlines()
-        try:
-            scenarios = build_scenarios(args, outlines_of)
-        except ValueError as err:
-            sys.stderr.write("evaluate: %s\n" % err)
-            return 2
-        say("%d runs: %d world(s) x %d start(s) x %d seed(s), %g s of sim time each" % (
-            len(scenarios), len(args.world), len(scenarios) // max(1, len(args.world) * len(args.seeds)),
-            len(args.seeds), args.duration))
-        options = RunOptions(output=args.output, reuse=not args.no_reuse, bag=args.bag,
-                             picture=args.pictures, connect_timeout=args.connect_timeout,
-                             run_timeout=args.run_timeout, warm_start=not args.cold_start)
-        records = run_batch(scenarios, options, scheduler=args.scheduler, workers=args.workers,
-                            resume=not args.fresh, progress=not args.no_progress, say=say)
-        report(args, records, outlines_of, scenarios)
-        return 0
-    except Interrupted as err:
-        sys.stderr.write("evaluate: interrupted (%s); every process of the batch stopped; the "
-                         "runs done are in %s (run the same command again to resume)\n"
-                         % (err, os.path.join(args.output, "results.json")))
-        return 130
-    except KeyboardInterrupt:
-        sys.stderr.write("evaluate: interrupted\n")
-        return 130
-    except OSError as err:
-        sys.stderr.write("evaluate: %s\n" % err)
-        return 1
+        scenarios = build_scenarios(args, outlines_of)
+    except ValueError as err:
+        raise BadInput(err) from None
+    say("%d runs: %d world(s) x %d start(s) x %d seed(s), %g s of sim time each" % (
+        len(scenarios), len(args.world), len(scenarios) // max(1, len(args.world) * len(args.seeds)),
+        len(args.seeds), args.duration))
+    options = RunOptions(output=args.output, reuse=not args.no_reuse, bag=args.bag,
+                         picture=args.pictures, connect_timeout=args.connect_timeout,
+                         run_timeout=args.run_timeout, warm_start=not args.cold_start)
+    records = run_batch(scenarios, options, scheduler=args.scheduler, workers=args.workers,
+                        resume=not args.fresh, progress=not args.no_progress, say=say)
+    report(args, records, outlines_of, scenarios)
+    return 0
 
 
 if __name__ == "__main__":

@@ -28,8 +28,9 @@ from typing import Optional, Tuple
 
 from .gazebo import call_empty
 from .names import PAUSE_SERVICE, UNPAUSE_SERVICE, WORLD_PROPERTIES_SERVICE
-from .processes import Interrupted, raise_on_signals
+from .processes import raise_on_signals
 from .session import Session, SessionError
+from .tool_exit import exit_status
 
 # program -> (launch file in motion_plan/test/series_style, the switch service the run calls
 # or None when the program switches its own behaviours, its nodes' connections to the
@@ -273,7 +274,8 @@ def main(argv=None):
         parser.error("--goal X Y is needed for %s" % args.program)
     raise_on_signals()
     records = []
-    try:
+
+    def runs():
         with SeriesSession(os.path.join(args.output, "logs")) as series:
             for mode in args.modes:
                 for _ in range(args.repeat):
@@ -286,13 +288,8 @@ def main(argv=None):
                     if args.json:
                         with open(args.json, "w") as out:
                             json.dump(records, out, indent=1)
-    except SessionError as err:
-        sys.stderr.write("series_runs: %s\n" % err)
-        return 1
-    except Interrupted:
-        sys.stderr.write("series_runs: interrupted; everything it started is stopped\n")
-        return 130
-    return 0
+    return exit_status("series_runs", runs, interrupted="everything it started is stopped",
+                       known=(SessionError,))
 
 
 if __name__ == "__main__":

@@ -25,6 +25,7 @@ import sys
 from ..paths import ROOT
 from . import classroom, scoring
 from .spec import DEFAULT_SPEC, SpecError, load
+from ..tool_exit import BadInput, exit_status
 
 
 def parse_args(argv):
@@ -69,40 +70,31 @@ def say(text):
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
     args.output = os.path.abspath(args.output)
-    from ..processes import Interrupted
+    return exit_status("grade", lambda: grade(args), interrupted=(
+        "every process of the batch stopped; run the same command again to resume"))
+
+
+def grade(args):
+    if args.replay is not None:
+        from .replay import replay
+        return replay(args.output, *args.replay, gui=args.gui, say=say)
     try:
-        if args.replay is not None:
-            from .replay import replay
-            return replay(args.output, *args.replay, gui=args.gui, say=say)
-        try:
-            spec = load(args.spec)
-            submissions = classroom.discover(os.path.abspath(args.class_dir))
-        except (SpecError, ValueError) as err:
-            sys.stderr.write("grade: %s\n" % err)
-            return 2
-        from .grading import GradeError, grade_class
-        try:
-            graded = grade_class(spec, submissions, args, say)
-        except GradeError as err:
-            sys.stderr.write("grade: %s\n" % err)
-            return 2
-        from . import report
-        report.write(args.output, spec, graded)
-        say("class table %s" % os.path.join(args.output, "index.html"))
-        say("gradebook %s; all results %s" % (os.path.join(args.output, "grades.csv"),
-                                              os.path.join(args.output, "results.json")))
-        print(scoring.table(spec, graded), flush=True)
-        return 0
-    except Interrupted as err:
-        sys.stderr.write("grade: interrupted (%s); every process of the batch stopped; run the "
-                         "same command again to resume\n" % err)
-        return 130
-    except KeyboardInterrupt:
-        sys.stderr.write("grade: interrupted\n")
-        return 130
-    except OSError as err:
-        sys.stderr.write("grade: %s\n" % err)
-        return 1
+        spec = load(args.spec)
+        submissions = classroom.discover(os.path.abspath(args.class_dir))
+    except (SpecError, ValueError) as err:
+        raise BadInput(err) from None
+    from .grading import GradeError, grade_class
+    try:
+        graded = grade_class(spec, submissions, args, say)
+    except GradeError as err:
+        raise BadInput(err) from None
+    from . import report
+    report.write(args.output, spec, graded)
+    say("class table %s" % os.path.join(args.output, "index.html"))
+    say("gradebook %s; all results %s" % (os.path.join(args.output, "grades.csv"),
+                                          os.path.join(args.output, "results.json")))
+    print(scoring.table(spec, graded), flush=True)
+    return 0
 
 
 if __name__ == "__main__":

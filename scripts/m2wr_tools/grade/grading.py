@@ -56,7 +56,6 @@ def _private(folder, isolating):
 
 def plan(spec, submissions, output):
     """(scenarios to run, records of runs failed before starting, shadowed package names)."""
-    from ..paths import ROOT   # noqa: F401  (the project's env is the base)
     stage_root = os.path.join(output, "stage")
     _private(stage_root, sandbox.isolating())
     shadowed = {t.command[1] for t in spec.tasks if len(t.command) > 1}
