@@ -9,6 +9,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from pybullet_gazebo.engine.diff_drive import DiffDrive, Odometry
 from pybullet_gazebo.engine.specs import PluginSpec
+from pybullet_gazebo.ros.plugin_names import drive_names
 
 STEP = 0.005                    # [s]
 
@@ -284,8 +285,7 @@ def test_reset_zeroes_the_command(tmp_path):
 def test_parameters_as_noetic_reads_them(tmp_path):
     sim = Sim(tmp_path)
     d = sim.drive
-    assert (d.command_topic, d.odometry_topic, d.odometry_frame, d.robot_base_frame) == \
-        ("cmd_vel", "odom", "odom", "link_chassis")
+    assert drive_names(d.plugin_params) == ("cmd_vel", "odom", "odom", "link_chassis")
     assert d.update_rate == 20.0 and d.publish_odom_tf is True and d.publish_tf is True
     assert d.wheel_separation == 0.4 and d.wheel_radius == 0.1
     assert d.wheel_torque == 5.0                       # <torque> 0.1 is not read by Noetic
@@ -300,8 +300,7 @@ def test_parameters_as_noetic_reads_them(tmp_path):
     params = {"leftJoint": "joint_left_wheel", "rightJoint": "joint_right_wheel",
               "wheelTorque": "2.5", "wheelSeparation": "0.3", "wheelDiameter": "0.2"}
     d = Sim(tmp_path, params).drive
-    assert (d.command_topic, d.odometry_topic, d.odometry_frame, d.robot_base_frame) == \
-        ("cmd_vel", "odom", "odom", "base_footprint")
+    assert drive_names(d.plugin_params) == ("cmd_vel", "odom", "odom", "base_footprint")
     assert d.update_rate == 100.0 and d.wheel_torque == 2.5 and d.publish_odom_tf is True
     assert d.publish_wheel_tf is False
 

@@ -11,6 +11,7 @@ from pybullet_gazebo.engine.ray_sensor import LaserScanData, RaySensor
 from pybullet_gazebo.engine.raycast import RayCaster
 from pybullet_gazebo.engine.specs import PluginSpec, RaySensorSpec
 from pybullet_gazebo.engine.transforms import Pose
+from pybullet_gazebo.ros.plugin_names import laser_names
 
 WALL_X = 2.0                    # [m] near face of the wall
 WALL_HALF_WIDTH = 1.5           # [m] the wall spans |y| <= 1.5
@@ -72,11 +73,10 @@ def test_scan_metadata_and_exact_ranges_without_noise(client, scene):
     robot, caster = scene
     spec = laser_spec(noise_stddev=0.0)
     sensor = RaySensor(client, robot, -1, spec, caster, np.random.default_rng(0))
-    assert sensor.topic == "/m2wr/laser/scan"
-    assert sensor.frame_id == "sensor_laser"
+    assert laser_names(sensor.plugin_params, spec.link) == ("/m2wr/laser/scan", "sensor_laser")
     scan = sensor.measure(1.25)
     assert isinstance(scan, LaserScanData)
-    assert scan.stamp == 1.25 and scan.frame_id == "sensor_laser"
+    assert scan.stamp == 1.25
     assert scan.angle_min == pytest.approx(-1.570796)
     assert scan.angle_max == pytest.approx(1.570796)
     assert scan.angle_increment == pytest.approx(2 * 1.570796 / 719)
@@ -178,8 +178,8 @@ def test_sensor_on_a_child_link(client, tmp_path):
     spec = laser_spec(pose=Pose(), noise_stddev=0.0,
                       plugin=PluginSpec("laser", "libgazebo_ros_laser.so", {}))
     sensor = RaySensor(client, body, 0, spec, caster, np.random.default_rng(0))
-    assert sensor.frame_id == "sensor_laser"          # no frameName: the link's name
-    assert sensor.topic == "/world"                   # gazebo_ros_laser's default
+    # no frameName: the link's name; no topicName: gazebo_ros_laser's default
+    assert laser_names(sensor.plugin_params, spec.link) == ("/world", "sensor_laser")
     scan = sensor.measure(0.0)
     assert scan.ranges[AHEAD] == pytest.approx(2.85 / math.cos(AHEAD_ANGLE), abs=1e-6)
     angle = spec.min_angle + 500 * sensor.angle_increment

@@ -10,10 +10,10 @@ Plugin parameters, read as Noetic reads them (default in brackets):
   wheelAcceleration [0 = no limit, m/s^2 of wheel rim speed]
   updateRate [100 Hz; <= 0 = every step]  wheel targets and odometry are updated at this
                              rate of sim time
-  robotNamespace [absent]    namespace of the topics; when absent, the spawn's (kept as
-                             own_namespace for the ROS side, which names topics and frames)
-  commandTopic [cmd_vel], odometryTopic [odom], odometryFrame [odom],
-  robotBaseFrame [base_footprint], odometrySource [world | encoder]
+  robotNamespace, commandTopic, odometryTopic, odometryFrame, robotBaseFrame: ROS names,
+                             kept in plugin_params and read by the ROS side
+                             (ros/plugin_names.py)
+  odometrySource [world | encoder]
   publishTf [true]           false: Noetic publishes no odometry at all (due() stays false)
   publishOdomTF [true], publishWheelTF [false], publishWheelJointState [false: the
                              stand-in publishes the wheel joint states whatever it says,
@@ -126,12 +126,7 @@ class DiffDrive(Part):
         read = ParameterReader(params, where, label="<%s>")
         text, number, boolean = read.text, read.number, read.boolean
 
-        own_namespace = params.get("robotNamespace")
-        self.own_namespace = own_namespace.strip() if own_namespace is not None else None
-        self.command_topic = text("commandTopic", "cmd_vel")
-        self.odometry_topic = text("odometryTopic", "odom")
-        self.odometry_frame = text("odometryFrame", "odom")
-        self.robot_base_frame = text("robotBaseFrame", "base_footprint")
+        self.plugin_params = params             # its topic and frame names: the ROS side's
         self.publish_tf = boolean("publishTf", True)
         self.publish_wheel_tf = boolean("publishWheelTF", False)
         self.publish_odom_tf = boolean("publishOdomTF", True)
@@ -198,9 +193,9 @@ class DiffDrive(Part):
         except (TypeError, ValueError):
             v = w = math.nan
         if not (math.isfinite(v) and math.isfinite(w)):
-            self._warn_once("non-finite", "diff drive '%s': ignored a %s command with a "
+            self._warn_once("non-finite", "diff drive '%s': ignored a command with a "
                             "non-finite value (%s, %s); the previous command stays (reported "
-                            "once)" % (self.name, self.command_topic, linear_x, angular_z))
+                            "once)" % (self.name, linear_x, angular_z))
             return False
         self.command = (v, w)
         self._fresh = True

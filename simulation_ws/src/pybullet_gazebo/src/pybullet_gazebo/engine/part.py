@@ -46,7 +46,8 @@ same key to the publishers and subscribers of the part. A new part is one Part s
 the registry plus one binding.
 """
 from dataclasses import dataclass
-from typing import Callable, Dict, Optional
+from types import MappingProxyType
+from typing import Callable, Dict, Mapping, Optional
 
 from .specs import RobotSpec
 
@@ -88,8 +89,9 @@ class Part:
     """Base class of every robot part; see the module docstring for the contract."""
 
     KEY: str = ""                   # the <plugin filename> or <sensor type> it stands in for
-    # the plugin's own <robotNamespace>, None when absent: the ROS side then uses the spawn's
-    own_namespace: Optional[str] = None
+    # the <plugin>'s tags as written: the ROS side reads its names (topics, frames, the
+    # plugin's own namespace) from them (ros/plugin_names.py); the engine keeps no ROS name
+    plugin_params: Mapping[str, str] = MappingProxyType({})
 
     @classmethod
     def build(cls, context: PartContext, spec) -> "Part":

@@ -9,11 +9,9 @@ which start at the minimum range) and never sees the robot's own body. No return
 from the generator passed in (seedable), and a noisy return is kept inside
 [range_min, range_max] as Gazebo does.
 
-Plugin parameters read (libgazebo_ros_laser.so): `topicName` (Noetic's default "/world"),
-`frameName` (default: the sensor's link name; Noetic's own default is "/world"; a leading
-"/" is dropped, as tf does), `robotNamespace` (kept as `own_namespace`; None when absent).
-The ROS adapter publishes `measure()`'s LaserScanData on
-`topic` with `frame_id`, stamped with the sim time passed in. Measurements are due at
+The plugin's parameters (libgazebo_ros_laser.so) are kept as `plugin_params`: the ROS
+adapter reads its topic and frame from them (ros/plugin_names.py) and publishes
+`measure()`'s LaserScanData there, stamped with the sim time passed in. Measurements are due at
 `update_rate` [Hz] of sim time (0 = every step).
 """
 from dataclasses import dataclass
@@ -42,7 +40,6 @@ def _due(last, sim_time, period):
 class LaserScanData:
     """What a sensor_msgs/LaserScan carries, without ROS."""
     stamp: float                # sim time [s]
-    frame_id: str
     angle_min: float            # [rad]
     angle_max: float            # [rad]
     angle_increment: float      # [rad]
@@ -71,11 +68,8 @@ class RaySensor(Part):
         self.spec = spec
         self._caster = caster
         self.rng = rng                       # numpy Generator; reseed() swaps it on reset
-        params = spec.plugin.params if spec.plugin is not None else {}
-        own_namespace = params.get("robotNamespace")      # None: the spawn's namespace
-        self.own_namespace = own_namespace.strip() if own_namespace is not None else None
-        self.topic = params.get("topicName", "/world").strip()
-        self.frame_id = params.get("frameName", spec.link).strip().lstrip("/")
+        # its topic and frame names: the ROS side's (ros/plugin_names.py)
+        self.plugin_params = dict(spec.plugin.params) if spec.plugin is not None else {}
         self.update_rate = float(spec.update_rate)                   # [Hz]
         self._period = 1.0 / self.update_rate if self.update_rate > 0 else 0.0   # [s]
         samples = int(spec.samples)
@@ -195,6 +189,6 @@ class RaySensor(Part):
                                 out)
         self._last = sim_time
         return LaserScanData(
-            stamp=sim_time, frame_id=self.frame_id, angle_min=angle_min, angle_max=angle_max,
+            stamp=sim_time, angle_min=angle_min, angle_max=angle_max,
             angle_increment=self.angle_increment, time_increment=0.0, scan_time=self._period,
             range_min=range_min, range_max=range_max, ranges=out)

@@ -35,7 +35,7 @@ from tf2_msgs.msg import TFMessage
 from pybullet_gazebo.engine.diff_drive import DiffDrive
 from pybullet_gazebo.engine.joint_states import JointStatePublisher
 from pybullet_gazebo.engine.ray_sensor import RaySensor
-from pybullet_gazebo.ros import conversions, robot_namespace
+from pybullet_gazebo.ros import conversions, plugin_names, robot_namespace
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.watch_rate import WallRateLimit, topic_limit
 
@@ -60,7 +60,8 @@ class Binding:
         # publishers whose subscribers take part in the loop (clock_topic.py): sensors, odometry
         self.loop_publishers: List[DirectPublisher] = []
         self.subscribers: List[rospy.Subscriber] = []
-        self.namespace = robot_namespace.plugin_namespace(robot.namespace, part.own_namespace)
+        self.namespace = robot_namespace.plugin_namespace(
+            robot.namespace, plugin_names.own_namespace(part.plugin_params))
 
     def topic(self, name):
         """A part's topic name resolved in its namespace (absolute names stay)."""
@@ -101,10 +102,11 @@ class Binding:
 class LaserBinding(Binding):
     def __init__(self, robot, part, context):
         super().__init__(robot, part, context)
-        self.scans = DirectPublisher(self.topic(part.topic), LaserScan)   # see its docstring
+        names = plugin_names.laser_names(part.plugin_params, part.spec.link)
+        self.scans = DirectPublisher(self.topic(names.topic), LaserScan)   # see its docstring
         self.publishers.append(self.scans)
         self.loop_publishers.append(self.scans)
-        self.frame_id = self.frame(part.frame_id, fall_back_to_namespace=False)
+        self.frame_id = self.frame(names.frame, fall_back_to_namespace=False)
 
     def publish(self, data, stamp):
         self.scans.publish(conversions.scan_to_msg(data, stamp, self.frame_id))
@@ -114,32 +116,34 @@ class LaserBinding(Binding):
 class DriveBinding(Binding):
     def __init__(self, robot, part, context):
         super().__init__(robot, part, context)
-        self.odometry = DirectPublisher(self.topic(part.odometry_topic), Odometry)
+        self.names = plugin_names.drive_names(part.plugin_params)
+        self.odometry = DirectPublisher(self.topic(self.names.odometry_topic), Odometry)
         self.publishers.append(self.odometry)
         self.loop_publishers.append(self.odometry)
-        self.frames = (self.frame(part.odometry_frame, fall_back_to_namespace=True),
-                       self.frame(part.robot_base_frame, fall_back_to_namespace=True))
+        self.frames = (self.frame(self.names.odometry_frame, fall_back_to_namespace=True),
+                       self.frame(self.names.robot_base_frame, fall_back_to_namespace=True))
         # /tf is advertised once a robot needs it (an empty world offers no /tf, as Gazebo)
         self.tf = context.tf_publisher() if part.publish_odom_tf else None
-        self.subscribers.append(rospy.Subscriber(self.topic(part.command_topic), Twist,
+        self.subscribers.append(rospy.Subscriber(self.topic(self.names.command_topic), Twist,
                                                  self._on_command, queue_size=1))
 
     def _on_command(self, msg):
-        drive = self.part
         self.context.commands_by_node[msg._connection_header.get("callerid", "?")] += 1
         if not conversions.is_finite_twist(msg):
+            # all six fields, as a ROS user reads a Twist (the drive itself checks the two
+            # it uses, for callers without ROS)
             rospy.logwarn_throttle(5.0, "ignored a %s command for '%s' with NaN or inf: %s"
-                                   % (drive.command_topic, self.robot.name,
+                                   % (self.names.command_topic, self.robot.name,
                                       [msg.linear.x, msg.angular.z]))
-        else:
-            if self.context.debug:         # a per-message hot path: no work when not asked
-                rospy.logdebug_throttle(1.0, "%s for '%s': linear.x %.3f, angular.z %.3f"
-                                        % (drive.command_topic, self.robot.name, msg.linear.x,
-                                           msg.angular.z))
-            # Not under the world's lock: the loop holds it while it steps, and waiting for
-            # it here delayed commands by whole steps when running free. Setting the command
-            # is one attribute write, read by the drive at its next update.
-            drive.set_command(msg.linear.x, msg.angular.z)
+            return
+        if self.context.debug:         # a per-message hot path: no work when not asked
+            rospy.logdebug_throttle(1.0, "%s for '%s': linear.x %.3f, angular.z %.3f"
+                                    % (self.names.command_topic, self.robot.name, msg.linear.x,
+                                       msg.angular.z))
+        # Not under the world's lock: the loop holds it while it steps, and waiting for it
+        # here delayed commands by whole steps when running free. Setting the command is one
+        # attribute write, read by the drive at its next update.
+        self.part.set_command(msg.linear.x, msg.angular.z)
 
     def publish(self, data, stamp):
         odometry_heard = self.odometry.get_num_connections() > 0

@@ -60,11 +60,11 @@ class ScanMessage(LaserScan):
             buff.write(data.tobytes())
 
 
-def scan_to_msg(scan, stamp, frame_id=None):
-    """frame_id: the scan's frame as the ROS side resolved it (None: the sensor's own)."""
+def scan_to_msg(scan, stamp, frame_id):
+    """frame_id: the scan's frame as the ROS side resolved it."""
     msg = ScanMessage()
     msg.header.stamp = stamp
-    msg.header.frame_id = scan.frame_id if frame_id is None else frame_id
+    msg.header.frame_id = frame_id
     msg.angle_min = scan.angle_min
     msg.angle_max = scan.angle_max
     msg.angle_increment = scan.angle_increment
@@ -76,10 +76,10 @@ def scan_to_msg(scan, stamp, frame_id=None):
     return msg
 
 
-def odometry_to_msgs(odometry, drive, stamp, frames=None):
+def odometry_to_msgs(odometry, drive, stamp, frames):
     """(nav_msgs/Odometry, TransformStamped odom -> base) as gazebo_ros_diff_drive sends.
-    frames: (odometry frame, base frame) as the ROS side resolved them (None: the drive's)."""
-    odometry_frame, base_frame = frames or (drive.odometry_frame, drive.robot_base_frame)
+    frames: (odometry frame, base frame) as the ROS side resolved them."""
+    odometry_frame, base_frame = frames
     msg = Odometry()
     msg.header.stamp = stamp
     msg.header.frame_id = odometry_frame
