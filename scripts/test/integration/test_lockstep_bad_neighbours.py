@@ -1,6 +1,7 @@
 """Lockstep with misbehaving controllers (issue 26, bad input): beside obstacle_avoidance.py
 driving m2wr, robot b's controllers publish 1000 times a wall second, answer every odometry
-message twice, or read m2wr's scans and never answer. Lockstep is not stalled by them, m2wr's
+message twice, read m2wr's scans and never answer, or spin in a busy loop while switched off
+(taken for a busy loop and not waited for). Lockstep is not stalled by them, m2wr's
 trajectory is the same to the last bit as without them, and the run summary says what each
 sent and how long lockstep waited for whom. (scripts/test/fixtures/neighbours_run.py does
 one run in a subprocess: its own master, everything stopped by PID at its end.)"""
@@ -25,7 +26,7 @@ def neighbours_run(log_dir, *modes):
 
 def test_misbehaving_neighbours_do_not_change_m2wr_s_run(tmp_path):
     alone = neighbours_run(tmp_path / "alone")
-    beside = neighbours_run(tmp_path / "beside", "spam", "twice", "never")
+    beside = neighbours_run(tmp_path / "beside", "spam", "twice", "never", "spin")
     assert alone["sim_s"] == beside["sim_s"] >= SECONDS - 0.05
     assert alone["odom_messages"] == beside["odom_messages"]
     assert alone["m2wr"] == beside["m2wr"]            # the same pose, to the last bit
@@ -39,3 +40,5 @@ def test_misbehaving_neighbours_do_not_change_m2wr_s_run(tmp_path):
     assert "/bad_neighbour_never" not in counts
     lockstep, = [line for line in beside["summary"] if "lockstep:" in line]
     assert "0 time-outs" in lockstep and "waited for:" in lockstep
+    spinning, = [line for line in beside["summary"] if line.startswith("busy loops")]
+    assert "node /bad_neighbour_spin (pid " in spinning, spinning

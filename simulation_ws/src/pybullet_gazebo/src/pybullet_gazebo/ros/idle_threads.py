@@ -117,10 +117,11 @@ class _Thread:
 class ProcessThreads:
     """The threads of one process, their /proc stat files kept open (re-read with pread)."""
 
-    def __init__(self, pid):
+    def __init__(self, pid, on_spin=lambda pid, tid: None):
         self.pid = pid
         self.task_dir = "/proc/%d/task" % pid
         self.threads = {}           # tid -> _Thread
+        self.on_spin = on_spin      # told (pid, tid) when a thread is taken for a busy loop
 
     def busy_thread(self, now, round_start):
         """A tid that is running and not a busy loop (None: the process is idle), or False
@@ -149,6 +150,7 @@ class ProcessThreads:
             elif now - thread.busy_since >= SPIN_WALL and self._cpu_ns(tid) - \
                     thread.cpu_since >= SPIN_SHARE * 1e9 * (now - thread.busy_since):
                 thread.spinning = True
+                self.on_spin(self.pid, tid)
                 continue
             if busy is None:
                 busy = tid
@@ -342,9 +344,11 @@ class IdleWatch:
     FOLLOW = 0.01            # [s] wall: how long a wait may watch one running thread alone
                              # (then whole looks again, which find busy loops)
 
-    def __init__(self, own_busy=lambda: False, own_moved=lambda: False):
+    def __init__(self, own_busy=lambda: False, own_moved=lambda: False,
+                 on_spin=lambda pid, tid: None):
         self.own_busy = own_busy            # the simulator's own side (OwnReceivers.busy)
         self.own_moved = own_moved          # ... and its second look (OwnReceivers.moved)
+        self.on_spin = on_spin              # told (pid, tid) of a thread taken for a busy loop
         self.backlog = KernelBacklog()
         self.run_queue = RunQueue()
         self._processes = {}                # pid -> ProcessThreads
@@ -357,7 +361,7 @@ class IdleWatch:
             self._processes.pop(pid).close()
         for pid in pids:
             if pid not in self._processes:
-                self._processes[pid] = ProcessThreads(pid)
+                self._processes[pid] = ProcessThreads(pid, on_spin=self.on_spin)
 
     def note_sent(self):
         """A message went out to the watched processes (see ProcessThreads.note_sent)."""

@@ -77,10 +77,12 @@ class SimulatorNode:
             else params.real_time_factor
         self.pacer = RealTimePacer(self.real_time_factor, self.world.sim_time)
         self._node_processes = NodeProcesses(rospy.get_name())
+        self._busy_loops = set()            # lockstep: threads taken for busy loops (named)
         own_receivers = OwnReceivers()
         self.lockstep = Lockstep(
             params.lockstep, params.lockstep_timeout,
-            IdleWatch(own_busy=own_receivers.busy, own_moved=own_receivers.moved)
+            IdleWatch(own_busy=own_receivers.busy, own_moved=own_receivers.moved,
+                      on_spin=self._note_busy_loop)
             if params.lockstep else None,
             is_shutdown=rospy.is_shutdown, is_paused=lambda: self.paused,
             describe=self._describe_busy,
@@ -202,6 +204,9 @@ class SimulatorNode:
                       self.world.step_count, self.world.contacts.event_count,
                       "; lockstep: " + self.lockstep.stats.summary()
                       if self.params.lockstep else "")
+        if self._busy_loops:
+            rospy.loginfo("run summary: busy loops, not waited for (a thread that ran on "
+                          "without sleeping): %s", ", ".join(sorted(self._busy_loops)))
         commands = self._binding_context.commands_by_node
         if commands:
             rospy.loginfo("run summary: commands received: %s", ", ".join(
@@ -276,6 +281,14 @@ class SimulatorNode:
             "%s (pid %s)" % (n, self._node_processes.pid_of(n)) for n in sorted(names))
             or "no controller", "; and %s (pid %s), which their service calls go through" % (
                 MASTER, self._node_processes.pid_of(MASTER)) if names else "")
+
+    def _note_busy_loop(self, pid, tid):
+        """Lockstep took thread `tid` of `pid` for a busy loop: it is not waited for."""
+        what = "%s thread %d" % (self._describe_busy((pid, tid)), tid)
+        if what not in self._busy_loops:
+            self._busy_loops.add(what)
+            rospy.loginfo("lockstep: %s runs without sleeping (a busy loop): not waited for "
+                          "while it does", what)
 
     def _describe_busy(self, busy):
         """A name for what IdleWatch.busy() found at work (for the log and the summary)."""
