@@ -72,7 +72,9 @@ import time
 
 SPIN_WALL = 0.1          # [s] wall: running at every look for this long ...
 SPIN_SHARE = 0.25        # ... on at least this share of a CPU: a busy loop
-GIL_WAIT = 0.006         # [s] wall: longer than Python's 5 ms switch interval
+GIL_WAIT = 0.02          # [s] of the busy loop's CPU: 4 of Python's 5 ms switch intervals (a
+                         # waiter's 5 ms timed wake comes late on a loaded machine: 6 ms
+                         # let one in five unit runs take a GIL waiter for done)
 
 # system call numbers of the socket waits a reader sleeps in (x86_64, aarch64)
 SOCKET_WAITS = {
