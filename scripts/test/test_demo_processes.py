@@ -2,6 +2,7 @@
 The children here are `sleep` and `bash`, each in a session of its own, and are always
 stopped by the test that starts them."""
 import os
+import signal
 import socket
 import time
 import uuid
@@ -38,7 +39,14 @@ def exec_done(pid, program):
 
 def test_sigint_ends_a_well_behaved_child(tmp_path, run_env):
     uri, env = run_env
-    child = Child("sleeper", ["sleep", "30"], env, str(tmp_path / "sleeper.log"))
+    # A child inherits an ignored SIGINT (a test run started in the background by a
+    # non-interactive shell has SIGINT ignored, and Python then keeps it so), but a handled
+    # one is back to the default after exec: the tools handle it (raise_on_signals)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        child = Child("sleeper", ["sleep", "30"], env, str(tmp_path / "sleeper.log"))
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert child.running()
     # Between fork and exec the child still has this process's environment (so leftovers
     # cannot know it yet), and a SIGINT then is swallowed by the forked Python's handler; a
