@@ -12,6 +12,8 @@ Parameters (read before init_node, global names as in the series):
 Uses: /odom (nav_msgs/Odometry), /m2wr/laser/scan (sensor_msgs/LaserScan),
 /go_to_point_switch and /wall_follower_switch (std_srvs/SetBool), /gazebo/set_model_state.
 Logs each change of state and `goal reached` within 0.3 m; then both behaviours are off.
+Sets ~placed_at (the sim time [s] the robot was put at the start) or ~not_placed (the
+simulator's answer) after its set_model_state, for tests that must not miss it on /rosout.
 """
 import math
 
@@ -62,8 +64,10 @@ class Bug2:
         state.pose.position.x, state.pose.position.y = self.start
         answer = self.set_model_state(state)
         if answer.success:
+            rospy.set_param("~placed_at", rospy.get_time())     # [s] sim time, for tests
             rospy.loginfo("robot placed at (%.2f, %.2f)", *self.start)
         else:
+            rospy.set_param("~not_placed", answer.status_message)
             rospy.logwarn("robot not placed at (%.2f, %.2f): %s", self.start[0], self.start[1],
                           answer.status_message)
 
