@@ -35,6 +35,8 @@ from . import classroom, rules, sandbox
 from .spec import Limits
 
 CALL_LOG_PARAM = "/gazebo/call_log"     # pybullet_gazebo.ros.call_log.PARAM
+SET_MODEL_STATE = "/gazebo/set_model_state"
+PLACEMENT_WAIT = 5.0                    # [s] wall: longest wait for a bug program's placement
 SIMULATOR = "/gazebo"
 
 
@@ -140,7 +142,7 @@ class GradeRig(Rig):
         runner starts its controllers; anything else (roslaunch, a binary) through prlimit."""
         run = self.current
         env = run.env(self)
-        run.calls_from = _size(self._call_log())
+        run.calls_from = run.calls_start = _size(self._call_log())
         run.master = xmlrpc.client.ServerProxy(self.session.master_uri)
         isolating = sandbox.isolating()
         user = self.slot.uid if isolating else None
@@ -163,10 +165,28 @@ class GradeRig(Rig):
         rules stopped before the world ran ends its run here, whichever look found it: the
         watchdog's while it started (its processes stopped) or this one."""
         super()._wait_for_controller(controller, timeout, log_path, **kwargs)
-        if self.current is not None:
-            self.current.look(self)
-            if self.current.broken:
-                raise RunFailed(rules.verdict(self.current.findings))
+        run = self.current
+        if run is not None:
+            if "set_model_state_to_start" in run.scenario.allow:
+                self._wait_for_placement(run, controller)
+            run.look(self)
+            if run.broken:
+                raise RunFailed(rules.verdict(run.findings))
+
+    def _wait_for_placement(self, run, controller):
+        """A task that lets the program put m2wr at its start (the series' bug programs call
+        set_model_state as they start, after waiting for their services): the world stays
+        paused until the call log shows that call, for PLACEMENT_WAIT s of wall time at most
+        (a program that never calls it then starts as it is). Unpaused first, the run would
+        start a few ticks before the call on one grading and after it on the next."""
+        deadline = time.monotonic() + PLACEMENT_WAIT
+        while time.monotonic() < deadline and controller.running():
+            calls, _ = _read_calls(self._call_log(), run.calls_start)   # the watchdog
+            # moves calls_from on as it reads
+            if any(c.get("service") == SET_MODEL_STATE and c.get("caller") != NODE
+                   for c in calls):
+                return
+            time.sleep(0.02)
 
     def _stop_controller(self, known_exit):
         if self.current is not None and self.current.watchdog is not None:
@@ -187,7 +207,8 @@ class _Run:
         self.findings, self.seen = [], set()
         self.broken = False             # a finding no rule allows was seen
         self.watchdog = self.controller = self.master = None
-        self.calls_from = None
+        self.calls_from = None          # the call log's offset the next look reads from
+        self.calls_start = None         # ... and where it stood as the controller started
         self.peak_mib = 0.0
         self.leftovers = ""
         self._env = None
