@@ -502,9 +502,15 @@ class Rig:
         track = metrics.clip_track(np.array(rows).reshape(-1, 9), duration)
         if not len(track):
             raise RunFailed("no odometry was heard during the run")
-        end = float(track[-1, 0])
         goal_time = metrics.time_to_goal(track, task.goal, task.tolerance) \
             if task.kind == "goal" else None
+        if goal_time is not None:
+            # a goal run ends at the goal: the world is paused a few ticks later, as many as
+            # the wall clock lets pass (the run's wait looks every 0.1 s), so what came
+            # after (the final pose, the distance) would differ between the same runs
+            duration = goal_time
+            track = metrics.clip_track(track, goal_time)
+        end = float(track[-1, 0])
         sampled = metrics.decimate(track, CLEARANCE_PERIOD)
         poses = [Pose(tuple(r[1:3]) + (r[4],), tuple(r[5:9])) for r in sampled]
         scene = self._scene(scenario.world)
