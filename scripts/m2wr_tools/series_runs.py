@@ -11,8 +11,8 @@ A run: the world paused (world launch defaults but headless, legacy_mode:=true: 
 series' programs turn as REP 103 says, contacts:=true), m2wr spawned at the start, the
 program's launch file started and connected; then, still paused, the behaviour is switched
 on (go_to_point, follow_wall; bug2 switches its own, and puts the robot at its start with
-/gazebo/set_model_state, which the simulator's call log must show first), the clock of the run starts (sim time
-now), physics unpauses, and /odom is watched until the robot is within `tolerance` of the
+/gazebo/set_model_state, which the simulator's call log must show first), the clock of the
+run starts (sim time now), physics unpauses, and /odom is watched until the robot is within `tolerance` of the
 goal or `duration` of sim time has passed. The same steps in both modes, so that the only
 difference is the pacing: lockstep (real_time_factor 0) or real time (real_time_factor 1).
 """
@@ -26,6 +26,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from typing import Optional, Tuple
 
+from . import gazebo_calls
 from .gazebo import call_empty
 from .names import PAUSE_SERVICE, UNPAUSE_SERVICE, WORLD_PROPERTIES_SERVICE
 from .processes import raise_on_signals
@@ -50,7 +51,6 @@ PROGRAMS = {
               ("/bug2", "/odom"), ("/bug2", "/m2wr/laser/scan")],
              ("/bug2", "/gazebo/set_model_state")),
 }
-CALL_LOG_PARAM = "/gazebo/call_log"     # pybullet_gazebo.ros.call_log.PARAM
 MODES = ("lockstep", "real-time")
 
 
@@ -129,16 +129,6 @@ def sim_time_now():
     return rospy.ServiceProxy(WORLD_PROPERTIES_SERVICE, GetWorldProperties)().sim_time
 
 
-def called(call_log, node, service):
-    """Whether the simulator's call log has a request from `node` to `service`."""
-    try:
-        with open(call_log) as lines:
-            calls = [json.loads(line) for line in lines if line.strip()]
-    except (OSError, ValueError):
-        return False
-    return any(c.get("caller") == node and c.get("service") == service for c in calls)
-
-
 def wait_until(condition, timeout, what, check=lambda: None):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
@@ -155,10 +145,10 @@ def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
     from std_srvs.srv import SetBool
     launch_file, switch, connections, start_call = PROGRAMS[run.program]
     lockstep = run.mode == "lockstep"
-    call_log = os.path.join(session.log_dir, "gazebo_calls.jsonl")
+    call_log = os.path.join(session.log_dir, gazebo_calls.FILE_NAME)
     if os.path.exists(call_log):
         os.remove(call_log)
-    session.master().setParam("/series_runs", CALL_LOG_PARAM, call_log)
+    session.master().setParam("/series_runs", gazebo_calls.PARAM, call_log)
     session.launch_world(run.world, real_time_factor=0.0 if lockstep else 1.0,
                          lockstep=lockstep, paused=True, pub_clock_frequency=run.clock_hz,
                          contacts=True, extra=("legacy_mode:=true",))
@@ -180,7 +170,9 @@ def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
                        "%s did not connect to the simulator on %s" % (node, topic),
                        lambda: session.check_running(["world", "controller"]))
         if start_call is not None:
-            wait_until(lambda: called(call_log, *start_call), 60.0,
+            node, service = start_call
+            wait_until(lambda: gazebo_calls.called(gazebo_calls.read(call_log)[0], service,
+                                                   by=node), 60.0,
                        "%s did not call %s" % start_call,
                        lambda: session.check_running(["world", "controller"]))
         watcher.reset(run.goal, run.tolerance)

@@ -1,11 +1,13 @@
 """The grader's parts without a simulator: the spec (errors name the line and the field),
 the class folder (packages, loose scripts, nothing), the overlay that hides the project's
 motion_plan, the rules, the scores and the trajectory picture."""
+import json
 import os
 import textwrap
 
 import pytest
 
+from m2wr_tools import gazebo_calls
 from m2wr_tools.commands import check
 from m2wr_tools.grade import classroom, rules, scoring
 from m2wr_tools.grade.report import svg
@@ -241,3 +243,19 @@ def test_a_project_closed_to_other_users_is_named():
         assert sandbox.closed_to_others(project) is None
     finally:
         shutil.rmtree(top)
+
+
+def test_the_call_log_is_read_line_by_line_from_where_the_last_read_stopped(tmp_path):
+    path = tmp_path / "gazebo_calls.jsonl"
+    assert gazebo_calls.read(str(path)) == ([], 0)           # not there yet
+    first = {"service": "/gazebo/set_model_state", "caller": "/bug2", "sim_time": 0.0}
+    second = {"topic": "/gazebo/model_states", "subscriber": "/dan", "sim_time": 1.5}
+    path.write_text(json.dumps(first) + "\n" + json.dumps(second)[:10])   # one being written
+    entries, offset = gazebo_calls.read(str(path))
+    assert entries == [first] and offset == len(json.dumps(first)) + 1
+    with open(path, "w") as log:
+        log.write(json.dumps(first) + "\n" + json.dumps(second) + "\n")
+    assert gazebo_calls.read(str(path), offset) == ([second], path.stat().st_size)
+    assert gazebo_calls.called([first, second], "/gazebo/set_model_state", by="/bug2")
+    assert not gazebo_calls.called([first], "/gazebo/set_model_state", not_by="/bug2")
+    assert not gazebo_calls.called([second], "/gazebo/set_model_state")

@@ -2,8 +2,8 @@
 graded (the same scenario: world, start, seed, duration, command, the student's staged
 packages, rules and limits; lockstep), drawn to <output>/replay/<run_id>.png, with its
 metrics printed beside the graded record's and its record in <output>/replay/<run_id>.json;
-the last line says whether every measure is the graded one to the last digit. --gui opens the simulator's window and runs at
-real time (lockstep still: the same physics)."""
+the last line says whether every measure is the graded one to the last digit. --gui opens
+the simulator's window and runs at real time (lockstep still: the same physics)."""
 import json
 import os
 

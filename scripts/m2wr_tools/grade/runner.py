@@ -28,13 +28,12 @@ import time
 import xmlrpc.client
 from typing import Tuple
 
-from .. import processes
+from .. import gazebo_calls, processes
 from ..rig import NODE, Rig, RunFailed, RunOptions, run_on
 from ..scenarios import Scenario
 from . import classroom, rules, sandbox
 from .spec import Limits
 
-CALL_LOG_PARAM = "/gazebo/call_log"     # pybullet_gazebo.ros.call_log.PARAM
 SET_MODEL_STATE = "/gazebo/set_model_state"
 PLACEMENT_WAIT = 5.0                    # [s] wall: longest wait for a bug program's placement
 SIMULATOR = "/gazebo"
@@ -89,11 +88,11 @@ class GradeRig(Rig):
 
     # --- the simulator logs who calls its services ---------------------------------------
     def _call_log(self):
-        return os.path.join(self.session.log_dir, "gazebo_calls.jsonl")
+        return os.path.join(self.session.log_dir, gazebo_calls.FILE_NAME)
 
     def _ensure_simulator(self, scenario, options):
         # set before each (re)launch: a run may have changed the parameter
-        self.session.master().setParam(NODE, CALL_LOG_PARAM, self._call_log())
+        self.session.master().setParam(NODE, gazebo_calls.PARAM, self._call_log())
         return super()._ensure_simulator(scenario, options)
 
     # --- one run --------------------------------------------------------------------------
@@ -181,10 +180,9 @@ class GradeRig(Rig):
         start a few ticks before the call on one grading and after it on the next."""
         deadline = time.monotonic() + PLACEMENT_WAIT
         while time.monotonic() < deadline and controller.running():
-            calls, _ = _read_calls(self._call_log(), run.calls_start)   # the watchdog
-            # moves calls_from on as it reads
-            if any(c.get("service") == SET_MODEL_STATE and c.get("caller") != NODE
-                   for c in calls):
+            calls, _ = gazebo_calls.read(self._call_log(), run.calls_start)   # the
+            # watchdog moves calls_from on as it reads
+            if gazebo_calls.called(calls, SET_MODEL_STATE, not_by=NODE):
                 return
             time.sleep(0.02)
 
@@ -259,7 +257,7 @@ class _Run:
 
     def _look(self, rig, graph):
         sim_time = (rig.recorder.sim_time if rig.recorder is not None else None) or 0.0
-        calls, self.calls_from = _read_calls(rig._call_log(), self.calls_from)
+        calls, self.calls_from = gazebo_calls.read(rig._call_log(), self.calls_from)
         new = rules.service_findings(calls, self.scenario.allow,
                                      (self.scenario.x, self.scenario.y), ignore=(NODE,))
         users = rules.logged_topic_users(calls, ignore=(NODE, SIMULATOR))
@@ -321,19 +319,6 @@ def _size(path):
         return os.path.getsize(path)
     except OSError:
         return 0
-
-
-def _read_calls(path, offset):
-    """(the entries of the call log after `offset`, the offset after the last whole line)."""
-    try:
-        with open(path, "rb") as log:
-            log.seek(offset)
-            data = log.read()
-    except OSError:
-        return [], offset
-    whole = data[:data.rfind(b"\n") + 1]
-    return [json.loads(line) for line in whole.splitlines() if line.strip()], \
-        offset + len(whole)
 
 
 def grade_run(scenario, options):

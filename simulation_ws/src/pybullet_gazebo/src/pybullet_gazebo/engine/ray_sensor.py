@@ -11,8 +11,8 @@ from the generator passed in (seedable), and a noisy return is kept inside
 
 The plugin's parameters (libgazebo_ros_laser.so) are kept as `plugin_params`: the ROS
 adapter reads its topic and frame from them (ros/plugin_names.py) and publishes
-`measure()`'s LaserScanData there, stamped with the sim time passed in. Measurements are due at
-`update_rate` [Hz] of sim time (0 = every step).
+`measure()`'s LaserScanData there, stamped with the sim time passed in. Measurements are due
+at `update_rate` [Hz] of sim time (0 = every step).
 """
 from dataclasses import dataclass
 import math

@@ -12,7 +12,8 @@ link_states, contacts) or sends its first message (a publisher on set_model_stat
   {"topic": "/gazebo/model_states", "subscriber": "/dan", "sim_time": 0.0}
   {"topic": "/gazebo/set_model_state", "publisher": "/eve", "sim_time": 4.5}
 so a reader of the file needs no look at the master while the world runs. Unset (the
-default), nothing is logged and the services and topics are untouched. The batch grader (scripts/m2wr_tools/grade) reads it to enforce a task's
+default), nothing is logged and the services and topics are untouched. The batch grader
+(scripts/m2wr_tools/grade) reads it to enforce a task's
 rules; the file is the simulator's to write, so a node under test cannot rewrite it.
 
 The parameter is read here, once, rather than in params.py's SimulatorParams: it concerns

@@ -11,6 +11,8 @@ ROS adapter reads them (bindings.py); the engine never does.
 """
 from typing import Mapping, NamedTuple, Optional
 
+from pybullet_gazebo.engine.parameters import ParameterReader
+
 
 class DriveNames(NamedTuple):
     command_topic: str
@@ -24,23 +26,16 @@ class LaserNames(NamedTuple):
     frame: str
 
 
-def _text(params, tag, default):
-    raw = params.get(tag)
-    return default if raw is None else str(raw).strip()
-
-
 def own_namespace(params: Mapping[str, str]) -> Optional[str]:
-    raw = params.get("robotNamespace")
-    return raw.strip() if raw is not None else None
+    return ParameterReader(params, "plugin").text("robotNamespace", None)
 
 
 def drive_names(params: Mapping[str, str]) -> DriveNames:
-    return DriveNames(_text(params, "commandTopic", "cmd_vel"),
-                      _text(params, "odometryTopic", "odom"),
-                      _text(params, "odometryFrame", "odom"),
-                      _text(params, "robotBaseFrame", "base_footprint"))
+    text = ParameterReader(params, "diff drive plugin").text
+    return DriveNames(text("commandTopic", "cmd_vel"), text("odometryTopic", "odom"),
+                      text("odometryFrame", "odom"), text("robotBaseFrame", "base_footprint"))
 
 
 def laser_names(params: Mapping[str, str], link: str) -> LaserNames:
-    return LaserNames(_text(params, "topicName", "/world"),
-                      _text(params, "frameName", link).lstrip("/"))
+    text = ParameterReader(params, "laser plugin").text
+    return LaserNames(text("topicName", "/world"), text("frameName", link).lstrip("/"))
