@@ -115,6 +115,12 @@ class DriveTest(unittest.TestCase):
         command = Twist()
         command.linear.x = 0.6
         self.cmd.publish(command)
+        # the chassis pitches as it starts (the twist peaks near 0.7 m/s about 0.4 s after
+        # the command reaches the wheels), so the second is counted from the moment it does:
+        # free-running, the message may arrive a second of sim time after it was sent
+        deadline = time.monotonic() + 10
+        while self.last_odom.twist.twist.linear.x < 0.1 and time.monotonic() < deadline:
+            time.sleep(0.01)
         wait_until_sim_time(rospy.get_time() + 1.0)
         odom = self.last_odom
         self.cmd.publish(Twist())
