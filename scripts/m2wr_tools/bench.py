@@ -75,13 +75,14 @@ import statistics
 import sys
 
 from . import benchmath
-from .processes import Interrupted, raise_on_signals
+from .processes import raise_on_signals
 from .bench_engine import engine_figures
 from .bench_loop import (LOOP_PROGRAM, WORLD, START, Listener, launch_to_first_scan, measure_loop,
                          say, soak)
 from .benchmath import fmt
 from .paths import ROOT
 from .session import Session, SessionError
+from .tool_exit import exit_status
 
 SIMULATOR_DEFAULT_CLOCK_HZ = 100.0
 UNLIMITED = "listeners, watch_rate 0"
@@ -299,8 +300,8 @@ def main(argv=None):
                            "python": platform.python_version(),
                            "pybullet": pybullet.getAPIVersion()},
                "world": WORLD, "start": dict(zip(("x", "y", "yaw"), START)), "loop": {}}
-    status = 0
-    try:
+
+    def bench():
         if not (args.listeners_only or args.loop_program_only):
             say("engine alone (no ROS)")
             figures["engine"] = engine_figures()
@@ -325,15 +326,10 @@ def main(argv=None):
             loop_program_columns(session, listener, args, loops)
         else:
             whole_bench(session, listener, args, figures)
-    except SessionError as err:
-        sys.stderr.write("bench: %s\n" % err)
-        status = 1
-    except Interrupted as err:
-        sys.stderr.write("bench: interrupted (%s); stopping everything\n" % err)
-        status = 130
-    except Exception as err:
-        sys.stderr.write("bench: %s: %s\n" % (type(err).__name__, err))
-        status = 1
+
+    try:
+        status = exit_status("bench", bench, interrupted="stopping everything",
+                             known=(SessionError,), catch_all=True)
     finally:
         session.shut_down("bench")
     figures["machine"]["load_after"] = "%.2f" % os.getloadavg()[0]

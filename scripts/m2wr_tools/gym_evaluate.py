@@ -26,9 +26,10 @@ import time
 import numpy as np
 from m2wr_gym import geometry, observation, resources
 from m2wr_gym.env import M2wrEnv
-from m2wr_gym.policy import load
+from m2wr_gym.policy import PolicyFileError, load
 
 from . import tutorial_scripts
+from .tool_exit import exit_status
 
 STUCK_WINDOW = 1.0          # [s]
 STUCK_DISTANCE = 0.1        # [m]
@@ -202,7 +203,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    try:
-        sys.exit(main())
-    except KeyboardInterrupt:
-        sys.exit(130)
+    sys.exit(exit_status("gym_evaluate", main, bad_input=(PolicyFileError,)))
