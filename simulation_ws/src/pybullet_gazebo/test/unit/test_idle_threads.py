@@ -79,10 +79,12 @@ def answered(process):
 
 
 def settle(watch, timeout=5.0):
-    """What lockstep's settle does: a first look, then the wait."""
-    if watch.busy() is None:
+    """What lockstep's settle does: a first look, then the wait, which follows what the
+    first look found."""
+    busy = watch.busy()
+    if busy is None:
         return None
-    return watch.wait(time.monotonic() + timeout)
+    return watch.wait(time.monotonic() + timeout, busy=busy)
 
 
 def test_a_sleeping_process_is_idle(child):

@@ -12,6 +12,7 @@ class FakeWatch:
     def __init__(self, idle_at=0.0):
         self.idle_at = idle_at
         self.sent = 0
+        self.followed = []          # what each wait was told the look before it found
 
     def note_sent(self):
         self.sent += 1
@@ -21,7 +22,8 @@ class FakeWatch:
             return None
         return (4242, 4243)
 
-    def wait(self, deadline, interrupted=lambda: False):
+    def wait(self, deadline, interrupted=lambda: False, busy=None):
+        self.followed.append(busy)
         while self.busy() is not None:
             if time.monotonic() >= deadline or interrupted():
                 return self.busy()
@@ -53,6 +55,7 @@ def test_waits_until_the_controllers_are_idle():
     assert time.monotonic() - start >= 0.19 and not lock.unsettled
     assert (lock.stats.settles, lock.stats.waits, lock.stats.timeouts) == (1, 1, 0)
     assert told == []
+    assert watch.followed == [(4242, 4243)]     # the wait starts from the look that found it
 
 
 def test_idle_at_once_is_a_settle_without_a_wait():

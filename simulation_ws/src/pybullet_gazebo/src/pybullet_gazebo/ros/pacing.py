@@ -117,7 +117,7 @@ class Lockstep:
             self.stats.waits += 1
             first = self.describe(busy)
             busy = self.watch.wait(started + self.timeout,
-                                   lambda: self.is_paused() or self.is_shutdown())
+                                   lambda: self.is_paused() or self.is_shutdown(), busy)
             waited = time.monotonic() - started
             self.stats.wall_waiting += waited
             self.stats.waited_for[first] = self.stats.waited_for.get(first, 0.0) + waited
