@@ -1,4 +1,5 @@
-# Sourced by scripts/demo.sh and scripts/evaluate.sh: sets the project up when it is not yet
+# Sourced by every entry script but test.sh (demo, evaluate, grade, bench, train; test.sh
+# always runs setup.sh): sets the project up when it is not yet
 # (the venv with the current requirements and the tools package, both workspaces built) by
 # running scripts/setup.sh, then sources scripts/env.sh. Needs ROOT; $1 names the caller in
 # messages.

@@ -16,7 +16,7 @@ import time
 import uuid
 import xmlrpc.client
 
-from . import processes
+from . import processes, stale_nodes
 from .names import (COMMAND_TOPIC, CONTROLLER_NODE, SCAN_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH,
                     SPAWN_SERVICE, TUTORIAL_CONTROLLER, WORLD_LAUNCH)
 
@@ -64,7 +64,8 @@ class Session:
                     # what roscore's roslaunch does: every roslaunch started on this master
                     # then shares one run id (each would declare its own, and the second
                     # would stop at "run_id on parameter server does not match")
-                    self.master().setParam("/" + self.name, "/run_id", str(uuid.uuid1()))
+                    with self.master() as master:
+                        master.setParam("/" + self.name, "/run_id", str(uuid.uuid1()))
                     return self.master_uri
                 time.sleep(0.1)
             if master.running():
@@ -75,18 +76,21 @@ class Session:
                            % (attempts, master.log_tail()))
 
     def master(self):
+        """The master's XML-RPC proxy; use it in a `with` block, which closes its socket."""
         return xmlrpc.client.ServerProxy(self.master_uri)
 
     def master_pid(self):
         try:
-            code, _, pid = self.master().getPid("/" + self.name)
+            with self.master() as master:
+                code, _, pid = master.getPid("/" + self.name)
             return pid if code == 1 else None
         except (OSError, xmlrpc.client.Error):
             return None
 
     def node_uri(self, node):
         try:
-            code, _, uri = self.master().lookupNode("/" + self.name, node)
+            with self.master() as master:
+                code, _, uri = master.lookupNode("/" + self.name, node)
             return uri if code == 1 else None
         except (OSError, xmlrpc.client.Error):
             return None
@@ -96,7 +100,8 @@ class Session:
         if uri is None:
             return None
         try:
-            code, _, pid = xmlrpc.client.ServerProxy(uri).getPid("/" + self.name)
+            with xmlrpc.client.ServerProxy(uri) as proxy:
+                code, _, pid = proxy.getPid("/" + self.name)
             return pid if code == 1 else None
         except (OSError, xmlrpc.client.Error):
             return None
@@ -136,7 +141,8 @@ class Session:
 
     def service_offered(self, service):
         try:
-            code, _, uri = self.master().lookupService("/" + self.name, service)
+            with self.master() as master:
+                code, _, uri = master.lookupService("/" + self.name, service)
             return code == 1
         except (OSError, xmlrpc.client.Error):
             return False
@@ -206,7 +212,8 @@ class Session:
         if uri is None or peer_uri is None:
             return False
         try:
-            code, _, bus = xmlrpc.client.ServerProxy(uri).getBusInfo("/" + self.name)
+            with xmlrpc.client.ServerProxy(uri) as proxy:
+                code, _, bus = proxy.getBusInfo("/" + self.name)
         except (OSError, xmlrpc.client.Error):
             return False
         if code != 1:
@@ -245,15 +252,24 @@ class Session:
     # --- the end ------------------------------------------------------------------------
     def stop(self, names=None):
         """Stops the named children (default: all), the controller and the bag before the
-        simulator and the simulator before the master. Returns {name: how it ended}."""
+        simulator and the simulator before the master. Returns {name: how it ended}. The
+        master, if it stays, forgets the nodes that ended (stale_nodes.py: else the next node
+        of the same name could have the master shut down whatever took the old one's port)."""
         order = [["controller", "rosbag", "spawn"], ["world"], ["roscore"]]
         names = set(self.children) if names is None else set(names)
+        nodes = {}
+        if self.master_uri is not None and "roscore" not in names:
+            with self.master() as master:
+                nodes = stale_nodes.registered(master, "/" + self.name)
         for group in order + [[n for n in self.children if n not in sum(order, [])]]:
             batch = [self.children[n] for n in group if n in names and n in self.children]
             if batch:
                 self.stop_report.update(processes.stop(batch))
                 for child in batch:
                     del self.children[child.name]
+        if nodes:
+            with self.master() as master:
+                stale_nodes.forget_ended(master, "/" + self.name, nodes)
         return self.stop_report
 
     def shut_down(self, tool):
