@@ -95,8 +95,15 @@ class Wrenches(unittest.TestCase):
         spinning = self.gazebo.get_joint_properties("joint_left_wheel").rate[0]
         self.assertGreater(abs(spinning), 2.0)        # over the drive's 5 N m holding it
         self.gazebo.clear_joint_forces("joint_left_wheel")
-        self.gazebo.wait_sim(0.5)
-        self.assertLess(abs(self.gazebo.get_joint_properties("joint_left_wheel").rate[0]), 0.5)
+        # the drive's motor brings it to rest; how fast depends on how the robot rocks as the
+        # wheel stops (one CI run still read 0.79 rad/s 0.5 s after the clear): look for 2 s
+        rates = []
+        for _ in range(20):
+            self.gazebo.wait_sim(0.1)
+            rates.append(abs(self.gazebo.get_joint_properties("joint_left_wheel").rate[0]))
+            if rates[-1] < 0.5:
+                break
+        self.assertLess(rates[-1], 0.5, "still spinning 2 s after the clear: %s" % rates)
 
     def test_bad_input_is_answered_and_nothing_applied(self):
         nan = float("nan")
