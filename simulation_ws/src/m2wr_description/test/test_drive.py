@@ -132,6 +132,11 @@ class DriveTest(unittest.TestCase):
         odom_sub = rospy.Subscriber("/odom", Odometry,
                                     lambda m: odometry.__setitem__(m.header.stamp, m))
         tf_sub = rospy.Subscriber("/tf", TFMessage, lambda m: transforms.extend(m.transforms))
+        # Under load a new subscriber may connect a second after another: count from the
+        # moment both topics have delivered, so a late connection is not read as a lost message.
+        deadline = time.monotonic() + 10
+        while not (odometry and transforms) and time.monotonic() < deadline:
+            time.sleep(0.01)
         command = Twist()
         command.linear.x, command.angular.z = 0.3, 0.2
         self.cmd.publish(command)
