@@ -27,12 +27,17 @@ def find_in_package(package_dir, name, executable):
 
 
 def package_dir(package, env):
-    """The folder of `package` as rospack finds it on env's ROS_PACKAGE_PATH, or None."""
+    """The folder of `package` as rospack finds it on env's ROS paths, or None: the first
+    path (ROS_ROOT, then ROS_PACKAGE_PATH in order) that holds it wins. Crawled a path at a
+    time, stopping at the first that holds it: a graded run finds the student's package on
+    the first path, where crawling every path cost 7-10 ms of the run's start."""
     import rospkg
-    try:
-        return rospkg.RosPack(rospkg.get_ros_paths(env)).get_path(package)
-    except rospkg.ResourceNotFound:
-        return None
+    for path in rospkg.get_ros_paths(env):
+        try:
+            return rospkg.RosPack([path]).get_path(package)
+        except rospkg.ResourceNotFound:
+            continue
+    return None
 
 
 def _package_or_error(package, env, argv):

@@ -3,13 +3,16 @@ the class folder (packages, loose scripts, nothing), the overlay that hides the 
 motion_plan, the rules, the scores and the trajectory picture."""
 import json
 import os
+import subprocess
 import textwrap
+import time
 
 import pytest
 
 from m2wr_tools import gazebo_calls
-from m2wr_tools.commands import check
-from m2wr_tools.grade import classroom, rules, scoring
+from m2wr_tools import processes
+from m2wr_tools.commands import check, package_dir
+from m2wr_tools.grade import classroom, rules, sandbox, scoring
 from m2wr_tools.grade.report import svg
 from m2wr_tools.grade.spec import DEFAULT_SPEC, SpecError, load
 
@@ -132,6 +135,35 @@ def test_the_overlay_finds_the_students_package_never_the_projects(tmp_path):
     with pytest.raises(ValueError, match=r"\(%s\) has no file 'obstacle_avoidance.py'"
                        % (student / "motion_plan")):
         check(("rosrun", "motion_plan", "obstacle_avoidance.py"), overlay)
+
+
+def test_a_package_is_found_on_the_first_path_that_holds_it_as_rospack_finds_it(tmp_path):
+    first, second = tmp_path / "first", tmp_path / "second"
+    _package(str(first / "motion_plan"), scripts=())
+    _package(str(second / "pkgs" / "motion_plan"), scripts=())
+    _package(str(second / "my_worlds"), name="my_worlds", scripts=())
+    env = {"ROS_PACKAGE_PATH": "%s:%s" % (first, second)}
+    assert package_dir("motion_plan", env) == str(first / "motion_plan")
+    assert package_dir("my_worlds", env) == str(second / "my_worlds")
+    assert package_dir("no_such_package", env) is None
+    env["ROS_PACKAGE_PATH"] = "%s:%s" % (second, first)
+    assert package_dir("motion_plan", env) == str(second / "pkgs" / "motion_plan")
+
+
+def test_a_users_processes_are_listed_and_its_ended_ones_are_not():
+    live = subprocess.Popen(["sleep", "30"])
+    ended = subprocess.Popen(["true"])
+    try:
+        deadline = time.monotonic() + 5
+        while processes.alive(ended.pid) and time.monotonic() < deadline:
+            time.sleep(0.01)                      # a zombie until waited for
+        mine = sandbox.pids_of_user(os.getuid())
+        assert live.pid in mine and ended.pid not in mine and os.getpid() not in mine
+        assert live.pid not in sandbox.pids_of_user(os.getuid() + 12345)
+    finally:
+        live.kill()
+        live.wait()
+        ended.wait()
 
 
 def test_rules_allow_the_bug_programs_start_and_fail_everything_else():
