@@ -19,10 +19,9 @@ GRADE = os.path.join(ROOT, "scripts", "grade.sh")
 FIXTURES = os.path.join(ROOT, "scripts", "test", "fixtures")
 
 
-def grade(class_dir, output, *extra, timeout=300):
-    result = subprocess.run(["bash", GRADE, str(class_dir), "--spec",
-                             os.path.join(FIXTURES, "grade_spec.yaml"), "--output", str(output),
-                             "--workers", "2", "--no-progress", *extra],
+def grade(class_dir, output, *extra, timeout=300, spec=os.path.join(FIXTURES, "grade_spec.yaml")):
+    result = subprocess.run(["bash", GRADE, str(class_dir)] + (["--spec", spec] if spec else [])
+                            + ["--output", str(output), "--workers", "2", "--no-progress", *extra],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             timeout=timeout)
     return result.returncode, result.stdout
@@ -117,3 +116,40 @@ def test_the_fixture_class_gets_the_grades_a_teacher_expects(tmp_path):
     assert replayed.returncode == 0, replayed.stdout
     assert replayed.stdout.rstrip().endswith(
         "the replay is the graded run: every measure equal to the last digit"), replayed.stdout
+
+
+def test_the_default_spec_grades_a_class_not_written_in_the_series_style(tmp_path):
+    """The default spec (episodes 5-10) on the fixture class, whose students hand in one or
+    two programs each, written their own way: what they handed in is graded, each missing
+    program fails its task with the file it lacks, and the rules and limits hold."""
+    class_dir = tmp_path / "class"
+    shutil.copytree(os.path.join(FIXTURES, "class"), class_dir)
+    os.chmod(class_dir, 0o700)
+    status, text = grade(class_dir, tmp_path / "out", spec=None)
+    assert status == 0, text
+    with open(tmp_path / "out" / "grades.csv", newline="") as source:
+        rows = {r["student"]: r for r in csv.DictReader(source)}
+    tasks = ["ep5_avoid", "ep6_go_to_point", "ep7_follow_wall", "ep8_bug0", "ep9_bug1",
+             "ep10_bug2"]
+    scores = {s: [float(rows[s][t]) for t in tasks] + [float(rows[s]["total"])] for s in rows}
+    # ada's avoider drives its minute, her go to point reaches (2, 8); gus's avoider too
+    assert scores["ada"] == [20.0, 15.0, 0.0, 0.0, 0.0, 0.0, 35.0], rows["ada"]
+    assert scores["gus"] == [20.0, 0.0, 0.0, 0.0, 0.0, 0.0, 20.0], rows["gus"]
+    for student in ("bert", "cleo", "dan", "eve", "fay", "hal"):
+        assert scores[student] == [0.0] * 7, rows[student]
+    assert [rows[s]["rank"] for s in ("ada", "gus", "bert")] == ["1", "2", "3"]
+    data = json.loads((tmp_path / "out" / "results.json").read_text())
+    reasons = {(s, r["task"]): r["reason"] for s, student in data["students"].items()
+               for r in student["runs"]}
+    assert "has no file 'follow_wall.py'" in reasons["ada", "ep7_follow_wall"]
+    assert "has no launch file 'bug2.launch'" in reasons["ada", "ep10_bug2"]
+    assert "has no file 'obstacle_avoidance.py'" in reasons["bert", "ep5_avoid"]
+    assert reasons["bert", "ep6_go_to_point"].startswith("did not reach the goal (2.00, 8.00)")
+    assert reasons["cleo", "ep6_go_to_point"].startswith(
+        "rules: called /gazebo/set_model_state for m2wr at (2.00, 8.00), by /go_to_point")
+    assert reasons["dan", "ep6_go_to_point"].startswith(
+        "rules: subscribed to /gazebo/model_states, by /go_to_point")
+    assert reasons["eve", "ep6_go_to_point"].startswith("controller exited with status 1")
+    assert reasons["fay", "ep6_go_to_point"].startswith("resources: its processes used more "
+                                                       "than the 1536 MiB of memory allowed")
+    assert "no package.xml and no scripts" in reasons["hal", "ep5_avoid"]
