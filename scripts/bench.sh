@@ -8,7 +8,7 @@
 #   scripts/bench.sh --bug [--worlds world02 world03] [--output output/]
 #     the series' bug-2 runs in lockstep (m2wr_tools.bench_bug): x real time, lockstep
 #     time-outs, contact events
-#   scripts/bench.sh --grade [--students 30] [--workers N] [--output output/]
+#   scripts/bench.sh --grade [--students 30] [--workers N] [--rounds 2] [--output output/]
 #     a class of N students graded with the default spec (m2wr_tools.bench_grade): wall
 #     time, runs a minute, the grader's overhead a run beside the batch runner's
 # Prints the figures side by side and writes them to output/bench.json. Runs

@@ -15,11 +15,14 @@ copied in and out, the rules' last look, the end by PID). Medians: a worker's fi
 starts its simulator. The comparison is like for like: the class graded again on the spec's
 obstacle-avoider task alone (ep5, 60 s in world02, one seed), so that both workers run the
 same light controller as the batch runner's do, then the batch runner on the same program
-through scripts/evaluate.sh, from as many random free starts as the class had students. (In
-the whole class the other worker runs go to point, the wall follower and bug 2 beside an ep5
-run, which slowed its start by 10-30 ms and moved the ratio between 0.91 and 1.28.)
+through scripts/evaluate.sh, from as many random free starts as the class had students; the
+two in turn for --rounds rounds (the machine's speed drifts by more than the grader costs
+between minutes), each round's ratio printed and the ratio of all rounds' medians the
+figure. (In the whole class the other worker runs go to point, the wall follower and bug 2
+beside an ep5 run, which slowed its start by 10-30 ms and moved the ratio between 0.91 and
+1.28.)
 
-    scripts/bench.sh --grade [--students 30] [--workers 2] [--output output/]
+    scripts/bench.sh --grade [--students 30] [--workers 2] [--rounds 2] [--output output/]
 
 Prints the figures and writes <output>/bench_grade.json.
 """
@@ -160,26 +163,38 @@ def bench(args):
                  "--fresh"] + workers, "grading %d students" % len(names))
     records = _records(os.path.join(grade_out, "results.json"))
     graded = [r for r in records if r.get("overhead_s") is not None]
-    # like for like: the class on the obstacle avoider alone, then the batch runner on it
+    # like for like: the class on the obstacle avoider alone, then the batch runner on it,
+    # in turn for `rounds` rounds (the machine's speed drifts between minutes)
     alone_spec = os.path.join(output, "bench_grade_%s.yaml" % COMPARED_TASK)
     write_one_task_spec(alone_spec, COMPARED_TASK)
-    alone_out = os.path.join(output, "bench_grade_%s" % COMPARED_TASK)
-    _run([sys.executable, "-m", "m2wr_tools.grade.cli", class_dir, "--spec", alone_spec,
-          "--output", alone_out, "--fresh"] + workers,
-         "grading the class on %s alone" % COMPARED_TASK)
-    ep5 = [r for r in _records(os.path.join(alone_out, "results.json"))
-           if r.get("overhead_s") is not None]
-    # the batch runner on the same controller, as many runs as the class had of it
-    evaluate_out = os.path.join(output, "bench_grade_evaluate")
-    # one seed (a new seed relaunches the simulator, as the class's runs never do), starts
-    # drawn at random in the free space: as many distinct runs as the class had of ep5
-    _run([sys.executable, "-m", "m2wr_tools.evaluate", "--controller", TUTORIAL,
-          "--task", "wander", "--world", "world02", "--duration", str(DURATION),
-          "--seeds", "0", "--random", str(max(2, len(names))), "--pose-seed", "0",
-          "--output", evaluate_out, "--fresh", "--no-progress"] + workers,
-         "the batch runner on the same controller")
-    with open(os.path.join(evaluate_out, "results.json")) as source:
-        batch = [r for r in json.load(source)["runs"] if r.get("overhead_s") is not None]
+    ep5, batch, rounds = [], [], []
+    for index in range(args.rounds):
+        suffix = "_%d" % (index + 1)
+        alone_out = os.path.join(output, "bench_grade_%s%s" % (COMPARED_TASK, suffix))
+        _run([sys.executable, "-m", "m2wr_tools.grade.cli", class_dir, "--spec", alone_spec,
+              "--output", alone_out, "--fresh", "--no-progress"] + workers,
+             "round %d of %d: grading the class on %s alone"
+             % (index + 1, args.rounds, COMPARED_TASK))
+        graded_alone = [r for r in _records(os.path.join(alone_out, "results.json"))
+                        if r.get("overhead_s") is not None]
+        # one seed (a new seed relaunches the simulator, as the class's runs never do),
+        # starts drawn at random in the free space: as many runs as the class had students
+        evaluate_out = os.path.join(output, "bench_grade_evaluate%s" % suffix)
+        _run([sys.executable, "-m", "m2wr_tools.evaluate", "--controller", TUTORIAL,
+              "--task", "wander", "--world", "world02", "--duration", str(DURATION),
+              "--seeds", "0", "--random", str(max(2, len(names))), "--pose-seed", str(index),
+              "--output", evaluate_out, "--fresh", "--no-progress"] + workers,
+             "round %d of %d: the batch runner on the same controller"
+             % (index + 1, args.rounds))
+        with open(os.path.join(evaluate_out, "results.json")) as source:
+            batched = [r for r in json.load(source)["runs"] if r.get("overhead_s") is not None]
+        pair = (_median(_overheads(graded_alone)), _median(_overheads(batched)))
+        rounds.append({"grader_overhead_s_median": pair[0], "batch_overhead_s_median": pair[1],
+                       "ratio": round(pair[0] / pair[1], 2) if all(pair) else None})
+        print("[bench_grade] round %d: overhead a run [s wall, median] grader %s, batch runner "
+              "%s: %s" % (index + 1, pair[0], pair[1], rounds[-1]["ratio"]), flush=True)
+        ep5 += graded_alone
+        batch += batched
     figures = {
         "students": len(names), "runs": len(records), "graded_runs": len(graded),
         "workers": args.workers, "wall_s": round(wall, 1),
@@ -191,7 +206,7 @@ def bench(args):
         "grader_stages_ep5": _stage_medians(ep5),
         "batch_stages": _stage_medians(batch),
         "date": time.strftime("%Y-%m-%d %H:%M"), "load": os.getloadavg()[0],
-        "cores": os.cpu_count(),
+        "cores": os.cpu_count(), "rounds": rounds,
     }
     ratio = None
     if figures["grader_overhead_s_median_ep5"] and figures["batch_overhead_s_median"]:
@@ -202,9 +217,9 @@ def bench(args):
     print("[bench_grade] %(students)d students, %(runs)d runs (%(graded_runs)d ran the world) "
           "in %(wall_s).0f s with %(workers)s workers: %(runs_per_minute).1f runs a minute"
           % dict(figures, workers=args.workers or os.cpu_count()))
-    print("[bench_grade] overhead a run [s wall, median]: %s in the whole class; on the "
-          "obstacle avoider alone grader %s (of which its own files, last look and end %s), "
-          "batch runner %s: ratio %s (target <= 1.10)"
+    print("[bench_grade] overhead a run [s wall, median of all rounds]: %s in the whole class; "
+          "on the obstacle avoider alone grader %s (of which its own files, last look and end "
+          "%s), batch runner %s: ratio %s (target <= 1.10)"
           % (figures["grader_overhead_s_median"], figures["grader_overhead_s_median_ep5"],
              figures["grader_s_median_ep5"], figures["batch_overhead_s_median"],
              figures["overhead_ratio_ep5"]))
@@ -217,6 +232,9 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog="bench_grade", description=__doc__.split("\n\n")[0])
     parser.add_argument("--students", type=int, default=30)
     parser.add_argument("--workers", type=int, default=None, help="default: cores")
+    parser.add_argument("--rounds", type=int, default=2,
+                        help="rounds of the like-for-like comparison, grader and batch runner "
+                             "in turn (default 2); the ratio is of all rounds' runs")
     parser.add_argument("--output", default=os.path.join(ROOT, "output"))
     args = parser.parse_args(argv)
     try:
