@@ -49,7 +49,7 @@ def forget_ended(master, caller, before):
         for node, uri in sorted(before.items()):
             code, _, now = master.lookupNode(caller, node)
             if code == 1 and now == uri and not _answers(uri):
-                _unregister(master, node, uri)
+                unregister(master, node, uri)
                 ended.append(node)
     except (OSError, xmlrpc.client.Error):
         pass                                  # the master itself went: nothing to forget
@@ -68,8 +68,13 @@ def _answers(uri, timeout=0.5):
         return True                           # slow or unreachable: leave it alone
 
 
-def _unregister(master, node, uri):
-    code, _, (publishers, subscribers, services) = master.getSystemState(node)
+def unregister(master, node, uri, state=None):
+    """Drops every registration of `node` (at XML-RPC address `uri`) from the master: its
+    publishers, subscribers, services and rospy's own parameter subscriptions. `state`: the
+    master's getSystemState answer, if the caller has it already."""
+    if state is None:
+        state = master.getSystemState(node)[2]
+    publishers, subscribers, services = state
     for topic, nodes in publishers:
         if node in nodes:
             master.unregisterPublisher(node, topic, uri)

@@ -28,7 +28,7 @@ import time
 import xmlrpc.client
 from typing import Tuple
 
-from .. import gazebo_calls, processes
+from .. import gazebo_calls, processes, stale_nodes
 from ..rig import NODE, Rig, RunFailed, RunOptions, run_on
 from ..scenarios import Scenario
 from . import classroom, rules, sandbox
@@ -287,31 +287,16 @@ class _Run:
 
 
 def forget_nodes(master, keep):
-    """Unregisters from the master every publisher, subscriber and service of the nodes
-    other than `keep`: a run's nodes stopped with SIGKILL (the watchdog, the end by PID)
-    never unregister, and the next run's rules would see their subscriptions."""
-    code, _, (publishers, subscribers, services) = master.getSystemState(NODE)
+    """Unregisters from the master every node other than `keep` (stale_nodes.unregister): a
+    run's nodes stopped with SIGKILL (the watchdog, the end by PID) never unregister, and the
+    next run's rules would see their subscriptions."""
+    code, _, state = master.getSystemState(NODE)
     if code != 1:
         return
-    uris = {}
-
-    def uri(node):
-        if node not in uris:
-            found = master.lookupNode(NODE, node)
-            uris[node] = found[2] if found[0] == 1 else ""
-        return uris[node]
-    for listing, forget in ((publishers, master.unregisterPublisher),
-                            (subscribers, master.unregisterSubscriber)):
-        for topic, nodes in listing:
-            for node in nodes:
-                if node not in keep:
-                    forget(node, topic, uri(node))
-    for service, nodes in services:
-        for node in nodes:
-            if node not in keep:
-                found = master.lookupService(NODE, service)
-                if found[0] == 1:
-                    master.unregisterService(node, service, found[2])
+    nodes = {node for listing in state for _, names in listing for node in names} - set(keep)
+    for node in sorted(nodes):
+        found = master.lookupNode(NODE, node)
+        stale_nodes.unregister(master, node, found[2] if found[0] == 1 else "", state)
 
 
 def _size(path):

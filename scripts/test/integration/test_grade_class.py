@@ -19,7 +19,8 @@ GRADE = os.path.join(ROOT, "scripts", "grade.sh")
 FIXTURES = os.path.join(ROOT, "scripts", "test", "fixtures")
 
 
-def grade(class_dir, output, *extra, timeout=300, spec=os.path.join(FIXTURES, "grade_spec.yaml")):
+def grade(class_dir, output, *extra, timeout=300,
+          spec=os.path.join(FIXTURES, "grade_spec.yaml")):
     result = subprocess.run(["bash", GRADE, str(class_dir)] + (["--spec", spec] if spec else [])
                             + ["--output", str(output), "--workers", "2", "--no-progress", *extra],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
