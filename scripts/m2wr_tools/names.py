@@ -32,6 +32,7 @@ WORLD_PROPERTIES_SERVICE = "/gazebo/get_world_properties"
 # what a session launches
 WORLD_LAUNCH = ("my_worlds", "launch_world.launch")
 SPAWN_LAUNCH = ("m2wr_description", "spawn.launch")
+SPAWN_NODE = "/spawn_m2wr"                 # spawn.launch's node (it ends once m2wr is in)
 TUTORIAL_CONTROLLER = ("rosrun", "motion_plan", "obstacle_avoidance.py")
 DEFAULT_WORLD = "world02"                  # the world episode 5 means
 DEFAULT_START = (0.0, 8.0, 0.0)            # x [m], y [m], yaw [rad]: the tutorial's y:=8

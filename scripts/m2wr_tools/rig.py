@@ -53,7 +53,7 @@ import xmlrpc.client
 
 import numpy as np
 
-from . import metrics, processes
+from . import metrics, processes, stale_nodes
 from .gazebo import Services, model_poses
 from .names import (BASE_FRAME, COMMAND_TOPIC, CONTACTS_TOPIC, ODOM_TOPIC, PAUSE_SERVICE,
                     RESET_SIMULATION_SERVICE, ROBOT, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC,
@@ -102,6 +102,7 @@ class Rig:
         self.recorder = None
         self.commands = 0
         self._recorder_connected = None   # simulator pid the recorder was seen connected to
+        self._run_nodes = {}          # {node: XML-RPC address} seen on the master this run
         self.scenes = {}              # world -> scene.Scene (offline geometry)
         self.zygote = None            # zygote.Zygote of this session (warm Python controllers)
         self.services = Services()    # the simulator's services, connections kept between runs
@@ -260,11 +261,23 @@ class Rig:
             record.setdefault(name, False if name == "success" else "")
         return record
 
+    def _note_run_nodes(self):
+        """Adds the nodes registered on the master now to the run's (stale_nodes.registered).
+        A controller's node that shuts down, at the runner's SIGINT or by itself, takes back
+        its topics but not rospy's parameter subscription: the master keeps its name and
+        address, and when the next run's node of that name registers, it sends "shutdown"
+        to that address, to whatever process has taken the port since. Known while they
+        run, the stop makes the master forget them."""
+        with self.session.master() as master:
+            self._run_nodes.update(stale_nodes.registered(master, NODE))
+
     def _stop_controller(self, known_exit):
         if self.session is None:
             return known_exit
         child = self.session.child("controller")
-        report = dict(self.session.stop(["controller", "rosbag"])) if child is not None else {}
+        nodes, self._run_nodes = self._run_nodes, {}
+        report = dict(self.session.stop(["controller", "rosbag"], nodes=nodes)) \
+            if child is not None else {}
         self.session.stop_report.clear()
         if known_exit is not None:
             return known_exit
@@ -330,6 +343,7 @@ class Rig:
         controller = self._start_controller(self._resolve(scenario.controller), log_path,
                                             options.warm_start)
         self._wait_for_controller(controller, options.connect_timeout, log_path)
+        self._note_run_nodes()
         stage("controller_start_s")
         if options.bag:
             session.start_bag(os.path.join(runs_dir, scenario.run_id + ".bag"),
@@ -360,6 +374,7 @@ class Rig:
         paused_at = time.monotonic()
         unpaused = paused_at - start
         commands, contacts_sent = self._simulator_counts()
+        self._note_run_nodes()                 # before the SIGINT: see _stop_controller
         stage("sim_s")
         exit_status = stopped = None
         if not controller.running():

@@ -18,7 +18,7 @@ import xmlrpc.client
 
 from . import processes, stale_nodes
 from .names import (COMMAND_TOPIC, CONTROLLER_NODE, SCAN_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH,
-                    SPAWN_SERVICE, TUTORIAL_CONTROLLER, WORLD_LAUNCH)
+                    SPAWN_NODE, SPAWN_SERVICE, TUTORIAL_CONTROLLER, WORLD_LAUNCH)
 
 
 class SessionError(RuntimeError):
@@ -169,6 +169,8 @@ class Session:
             processes.stop([child], sigint_timeout=5.0)
             raise SessionError("spawning m2wr did not finish within %.0f s:\n%s"
                                % (timeout, child.log_tail()))
+        with self.master() as master:        # its node ended: see stale_nodes.py
+            stale_nodes.forget_gone(master, "/" + self.name, [SPAWN_NODE])
         log = child.log_tail(60)
         if code != 0 or "process has died" in log or "spawn_model:" in log:
             raise SessionError("spawning m2wr at (%g, %g, yaw %g) failed (roslaunch exit %d):\n%s"
@@ -250,15 +252,18 @@ class Session:
                                    % (name, child.returncode, _problem_lines(child.log_tail(40))))
 
     # --- the end ------------------------------------------------------------------------
-    def stop(self, names=None):
+    def stop(self, names=None, nodes=None):
         """Stops the named children (default: all), the controller and the bag before the
         simulator and the simulator before the master. Returns {name: how it ended}. The
         master, if it stays, forgets the nodes that ended (stale_nodes.py: else the next node
-        of the same name could have the master shut down whatever took the old one's port)."""
+        of the same name could have the master shut down whatever took the old one's port).
+        `nodes`: {node: address} (stale_nodes.registered) taken by a caller that signalled the
+        children before this call: a node that has already shut down is no longer listed
+        by topic, yet the master still holds it. Default: the nodes registered now."""
         order = [["controller", "rosbag", "spawn"], ["world"], ["roscore"]]
         names = set(self.children) if names is None else set(names)
-        nodes = {}
-        if self.master_uri is not None and "roscore" not in names:
+        nodes = dict(nodes or {})
+        if self.master_uri is not None and "roscore" not in names and not nodes:
             with self.master() as master:
                 nodes = stale_nodes.registered(master, "/" + self.name)
         for group in order + [[n for n in self.children if n not in sum(order, [])]]:

@@ -56,6 +56,21 @@ def forget_ended(master, caller, before):
     return ended
 
 
+def forget_gone(master, caller, names):
+    """Of the nodes `names`, those the master still holds at an address where nothing answers
+    any more are forgotten (a node that shut down by itself, such as spawn.launch's, keeps
+    only rospy's parameter subscription, so no topic lists it). Returns their names."""
+    before = {}
+    try:
+        for node in names:
+            code, _, uri = master.lookupNode(caller, node)
+            if code == 1:
+                before[node] = uri
+    except (OSError, xmlrpc.client.Error):
+        return []
+    return forget_ended(master, caller, before)
+
+
 def _answers(uri, timeout=0.5):
     """Whether something listens at the XML-RPC address `uri` (a refused connection: no)."""
     address = urlparse(uri)

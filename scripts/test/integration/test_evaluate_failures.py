@@ -65,3 +65,24 @@ def test_a_slow_controller_is_failed_by_the_run_timeout(tmp_path, run_evaluate,
     assert r["cmd_vel_messages"] >= 1
     assert r["sim_time_s"] < 20.0                # lockstep held the simulator for it
     no_process_left(data)
+
+
+def test_the_next_run_finds_no_record_of_the_last_runs_node(tmp_path, run_evaluate,
+                                                            no_process_left):
+    """Every run's controller is a node of the same name on the worker's master. rospy never
+    takes back one registration (stale_nodes.py), so unless the runner drops it, the master
+    keeps the stopped node's address, and when the next run's node registers it sends
+    "shutdown" there: to whatever process has taken that port since (another node of the
+    run, the simulator). The fixture asks the master before it registers."""
+    status, text, data = run_evaluate(
+        ["--controller", os.path.join(FIXTURES, "name_reuse_controller.py"), "--workers", "1",
+         "--duration", "2", "--start", "0", "8", "0", "--start", "-3", "2", "1",
+         "--start", "3", "-2", "0"], tmp_path / "reuse")
+    assert status == 0, text
+    assert len(data["runs"]) == 3
+    for r in data["runs"]:
+        with open(r["controller_log"]) as log:
+            lines = [line for line in log if line.startswith("master's record")]
+        assert lines == ["master's record of /name_reuse_probe at start: none\n"], \
+            (r["run_id"], lines)
+    no_process_left(data)

@@ -72,3 +72,22 @@ def test_a_stopped_node_is_forgotten_by_the_master(tmp_path):
     except OSError:
         stopped = True
     assert stopped, "the master outlived the session"
+
+
+def test_spawn_launchs_node_is_forgotten_once_m2wr_is_in(tmp_path):
+    """spawn.launch's node ends by itself once m2wr is spawned, keeping rospy's parameter
+    subscription: the next spawn (the batch runner relaunches the world for a new seed) would
+    have the master shut down whatever took its port, the new simulator among others."""
+    session = Session(str(tmp_path / "logs"), name="test_stale_nodes")
+    try:
+        session.start_master()
+        session.launch_world("world02", paused=True)
+        session.wait_for_simulator()
+        session.spawn(0.0, 8.0, 0.0)
+        log = os.path.join(session.log_dir, "ros", "master.log")
+        with open(log) as text:
+            assert "CACHEDPARAM [/rosout_disable_topics_generation] by /spawn_m2wr" in text.read()
+        assert lookup(session, "/spawn_m2wr") is None
+        assert lookup(session, "/gazebo") is not None        # the live one stays
+    finally:
+        session.stop()
