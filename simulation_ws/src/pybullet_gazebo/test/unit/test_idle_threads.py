@@ -1,7 +1,9 @@
 """Lockstep's barrier on real processes (no ROS): a child that works on what it is sent is
 waited for until it is done; a busy loop is found and not waited for; beside one, a thread
 waiting for the GIL is still waited for."""
+import ctypes
 import select
+import threading
 import subprocess
 import sys
 import textwrap
@@ -225,3 +227,32 @@ def test_the_quick_look_reads_threads_it_has_not_seen_before(child):
         assert threads.asleep_now() is not None
     finally:
         threads.close()
+
+
+def _timer_slack():
+    return ctypes.CDLL(None).prctl(30, 0, 0, 0, 0)          # PR_GET_TIMERSLACK [ns]
+
+
+def test_a_wait_asks_for_precise_sleeps_in_its_own_thread_only(child):
+    """A wait polls every 30 us: with Linux's default timer slack (50 us) each sleep would
+    last ~80 us. The thread that waits gets 1 ns; other threads keep theirs."""
+    worker = child(WORKER, "0.005")
+    watch = IdleWatch()
+    watch.watch([worker.pid])
+    slack = {}
+
+    def waiter():
+        ctypes.CDLL(None).prctl(29, 50000, 0, 0, 0)         # Linux's default: 50 us
+        slack["before"] = _timer_slack()
+        watch.note_sent()
+        worker.stdin.write("1\n")
+        worker.stdin.flush()
+        watch.wait(time.monotonic() + 5.0, busy=watch.busy())
+        slack["after"] = _timer_slack()
+    ours = _timer_slack()
+    thread = threading.Thread(target=waiter)
+    thread.start()
+    thread.join()
+    assert slack["before"] == 50000 and slack["after"] == 1
+    assert _timer_slack() == ours                           # this thread's is unchanged
+    assert answered(worker) == ["done 1"]
