@@ -75,16 +75,30 @@ class Services:
 
     def set_model_pose(self, name, x, y, z, yaw):
         """As set_model_pose() above."""
+        from geometry_msgs.msg import Pose
+        from pybullet_gazebo.engine.transforms import quaternion_from_rpy
+        pose = Pose()
+        pose.position.x, pose.position.y, pose.position.z = x, y, z
+        o = pose.orientation
+        o.x, o.y, o.z, o.w = quaternion_from_rpy(0.0, 0.0, yaw)
+        self.place(name, pose)
+
+    def place(self, name, pose):
+        """Model `name` at `pose` (geometry_msgs/Pose in the world frame), at rest."""
         from gazebo_msgs.msg import ModelState
         from gazebo_msgs.srv import SetModelState
-        from pybullet_gazebo.engine.transforms import quaternion_from_rpy
-        state = ModelState(model_name=name, reference_frame="world")
-        state.pose.position.x, state.pose.position.y, state.pose.position.z = x, y, z
-        o = state.pose.orientation
-        o.x, o.y, o.z, o.w = quaternion_from_rpy(0.0, 0.0, yaw)
+        state = ModelState(model_name=name, reference_frame="world", pose=pose)
         answer = self._call(SET_MODEL_STATE_SERVICE, SetModelState, state)
         if not answer.success:
             raise RuntimeError("set_model_state(%s) failed: %s" % (name, answer.status_message))
+
+    def model_pose(self, name):
+        """Model `name`'s pose (geometry_msgs/Pose in the world frame)."""
+        from gazebo_msgs.srv import GetModelState
+        answer = self._call(GET_MODEL_STATE_SERVICE, GetModelState, name, "")
+        if not answer.success:
+            raise RuntimeError("get_model_state(%s) failed: %s" % (name, answer.status_message))
+        return answer.pose
 
     def close(self, name=None):
         for key in [name] if name else list(self._proxies):

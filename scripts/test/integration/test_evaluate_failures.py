@@ -86,3 +86,23 @@ def test_the_next_run_finds_no_record_of_the_last_runs_node(tmp_path, run_evalua
         assert lines == ["master's record of /name_reuse_probe at start: none\n"], \
             (r["run_id"], lines)
     no_process_left(data)
+
+
+def test_a_run_starts_with_no_command_where_the_controller_put_the_robot(tmp_path,
+                                                                         run_evaluate):
+    """A command that reached the simulator before the run started (a rospy.Rate loop's
+    first turn lands or not, as the connection comes up) is forgotten, so runs start alike;
+    a set_model_state of the controller's own (the series' bug 2) is kept. The fixture puts
+    m2wr at (1, 7), sends 0.5 m/s once when connected, then nothing."""
+    status, text, data = run_evaluate(
+        ["--controller", os.path.join(FIXTURES, "early_command_controller.py"),
+         "--workers", "1", "--duration", "2", "--start", "0", "8", "0"], tmp_path / "early")
+    assert status == 0, text
+    [r] = data["runs"]
+    with open(r["controller_log"]) as log:
+        assert "start-up command published" in log.read()
+    assert r["cmd_vel_messages"] == 1
+    t0, x0, y0 = r["path"][0]
+    assert abs(x0 - 1.0) < 0.01 and abs(y0 - 7.0) < 0.01, r["path"][:3]
+    assert r["distance_m"] < 0.01, r["path"]       # 0.5 m/s for 2 s had it been kept
+    assert abs(r["final_x"] - 1.0) < 0.01 and abs(r["final_y"] - 7.0) < 0.01
