@@ -13,9 +13,10 @@ depends only on its scenario:
   else is a plain process) and publishing cmd_vel -> if a command already reached the
   simulator, /gazebo/reset_world and m2wr put back where it stood (the drive forgets a
   command sent as the controller started, which reached it or not as the connection came
-  up: every run starts alike) -> physics unpaused for `duration` s of sim time -> paused -> the controller sent SIGINT while the run is measured (the record's
-  controller_stop says so; a zygote's rospy program ends ~0.1 s later, m2wr_tools.warm_rospy)
-  -> its exit awaited (the next run's reset comes after it: none of its commands can reach
+  up: every run starts alike) -> physics unpaused for `duration` s of sim time -> paused ->
+  the controller sent SIGINT while the run is measured (the record's controller_stop says
+  so; a zygote's rospy program ends ~0.1 s later, m2wr_tools.warm_rospy) -> its exit
+  awaited (the next run's reset comes after it: none of its commands can reach
   that run).
 
 Per-run `stages` [s wall] in the record: reset_s, controller_start_s, sim_s, measure_s,
@@ -136,18 +137,19 @@ class Rig:
         import rospy
         rospy.init_node(NODE.lstrip("/"), disable_signals=True)
 
-    def _simulator_counts(self):
+    def _simulator_counts(self, contacts=True):
         """(cmd_vel messages the simulator has received from the publishers connected now,
         /gazebo/contacts messages it has written to the recorder), from its node's
         getBusStats and getBusInfo (XML-RPC; no subscription of the batch's to /cmd_vel
-        costs the controller a second connection). (None, None) when it does not answer."""
+        costs the controller a second connection). (None, None) when it does not answer.
+        `contacts` False: the commands only (no getBusInfo), contacts None."""
         uri = self.session.node_uri(SIMULATOR_NODE)
         if uri is None:
             return None, None
         node = xmlrpc.client.ServerProxy(uri)
         try:
             code, _, (published, subscribed, _) = node.getBusStats(NODE)
-            code_info, _, bus = node.getBusInfo(NODE)
+            code_info, _, bus = node.getBusInfo(NODE) if contacts else (1, "", [])
         except (OSError, xmlrpc.client.Error, ValueError):
             return None, None
         if code != 1 or code_info != 1:
@@ -157,6 +159,8 @@ class Rig:
         # for publications. getBusInfo: [connection id, peer, direction, transport, topic, ...]
         commands = sum(c[2] for topic, connections in subscribed if topic == COMMAND_TOPIC
                        for c in connections)
+        if not contacts:
+            return commands, None
         ours = {c[0] for c in bus if len(c) >= 5 and c[4] == CONTACTS_TOPIC and c[1] == NODE}
         contacts = [c[2] for topic, _, connections in published if topic == CONTACTS_TOPIC
                     for c in connections if c[0] in ours]
@@ -274,7 +278,7 @@ class Rig:
         the drive forget it (as Gazebo's diff drive forgets its command there), and the robot
         goes back where it stood (at the run's start, or where the controller itself put it
         with set_model_state, as bug 2 does). Physics is paused: nothing else moved."""
-        commands, _ = self._simulator_counts()
+        commands, _ = self._simulator_counts(contacts=False)
         if not commands:
             return
         pose = self.services.model_pose(ROBOT)

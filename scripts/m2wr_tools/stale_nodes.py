@@ -44,31 +44,31 @@ def forget_ended(master, caller, before):
     """Of `before` ({node: address}, from registered()), the nodes that still have that
     address on the master but no longer answer there: their registrations are dropped, so the
     master forgets them. Returns their names."""
-    ended = []
-    try:
-        for node, uri in sorted(before.items()):
-            code, _, now = master.lookupNode(caller, node)
-            if code == 1 and now == uri and not _answers(uri):
-                unregister(master, node, uri)
-                ended.append(node)
-    except (OSError, xmlrpc.client.Error):
-        pass                                  # the master itself went: nothing to forget
-    return ended
+    return _forget_silent(master, caller, sorted(before), before.get)
 
 
 def forget_gone(master, caller, names):
     """Of the nodes `names`, those the master still holds at an address where nothing answers
     any more are forgotten (a node that shut down by itself, such as spawn.launch's, keeps
     only rospy's parameter subscription, so no topic lists it). Returns their names."""
-    before = {}
+    return _forget_silent(master, caller, names, lambda node: None)
+
+
+def _forget_silent(master, caller, names, address_then):
+    """Unregisters each of `names` that the master holds at an address where nothing answers;
+    `address_then(node)`: the address it had when the caller saw it run (only that one is
+    forgotten: a new node of the name may have registered since), or None for any."""
+    ended = []
     try:
         for node in names:
             code, _, uri = master.lookupNode(caller, node)
-            if code == 1:
-                before[node] = uri
+            then = address_then(node)
+            if code == 1 and (then is None or uri == then) and not _answers(uri):
+                unregister(master, node, uri)
+                ended.append(node)
     except (OSError, xmlrpc.client.Error):
-        return []
-    return forget_ended(master, caller, before)
+        pass                                  # the master itself went: nothing to forget
+    return ended
 
 
 def _answers(uri, timeout=0.5):

@@ -3,10 +3,10 @@ waited for until it is done; a busy loop is found and not waited for; beside one
 waiting for the GIL is still waited for."""
 import ctypes
 import select
-import threading
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 
 import pytest
