@@ -198,6 +198,7 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         after = listener.snapshot()
         listener.stop_counting()
         scans, answers, handled = (a - b for a, b in zip(after, before))
+        edge = 0 if controller is None else 1     # a loop program (see every_scan_handled)
         missing = benchmath.missing_periods(listener.scan_stamps[before[0]:after[0]], SCAN_PERIOD)
         peak = processes.peak_rss_kib(sim_pid)
         with open(session.children["world"].log_path, errors="replace") as log:
@@ -217,8 +218,9 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         "check": {"scans_published": scans + missing, "scans_heard": scans,
                   "handled_by_controller": handled, "cmd_vel_answers": answers,
                   "missing_scans": missing,
-                  "every_scan_received": benchmath.every_scan_handled(scans, handled, missing),
-                  "verdict": benchmath.lockstep_verdict(scans, handled, answers, missing),
+                  "every_scan_received": benchmath.every_scan_handled(scans, handled, missing,
+                                                                      edge),
+                  "verdict": benchmath.lockstep_verdict(scans, handled, answers, missing, edge),
                   "lockstep_timeout_warnings": timeouts},
         "simulator_peak_rss_mib": peak / 1024.0 if peak else None,
     }

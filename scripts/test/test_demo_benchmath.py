@@ -33,6 +33,10 @@ def test_lockstep_verdict():
     assert benchmath.every_scan_handled(98, 100, 2)
     assert not benchmath.every_scan_handled(98, 98, 2)
     assert not benchmath.every_scan_handled(0, 0, 0)
+    # a loop program's count may gain or lose one tick at the window's paused edges
+    assert benchmath.every_scan_handled(100, 101, 0, edge=1)
+    assert benchmath.every_scan_handled(100, 99, 0, edge=1)
+    assert not benchmath.every_scan_handled(100, 102, 0, edge=1)
     assert benchmath.lockstep_verdict(100, 100, 99, 0) == (
         "yes: 100 scans published (100 heard by the bench), 100 handled by the controller, "
         "99 cmd_vel answers")

@@ -199,6 +199,29 @@ def test_work_handed_on_between_threads_and_processes_is_waited_for_to_the_end()
         relay.stdout.close()
 
 
+def test_idle_now_never_finds_a_busy_child_idle_and_never_waits(child):
+    """The loop's look between two physics steps (lockstep hands a /clock tick on when it
+    says idle): while the child computes it answers False at once, whatever the machine
+    runs; once the child sleeps in its read, a quiet machine lets it answer True."""
+    worker = child(WORKER, "0.08")                 # (under SPIN_WALL: no busy loop)
+    watch = IdleWatch()
+    watch.watch([worker.pid])
+    assert settle(watch) is None
+    watch.note_sent()
+    worker.stdin.write("1\n")
+    worker.stdin.flush()
+    time.sleep(0.01)                               # it computes for 0.08 s of CPU now
+    start = time.monotonic()
+    for _ in range(20):
+        assert not watch.idle_now()
+    assert time.monotonic() - start < 0.05         # looks, not waits
+    assert settle(watch) is None and answered(worker) == ["done 1"]
+    deadline = time.monotonic() + 5.0              # other jobs may keep the machine busy
+    while not watch.idle_now() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert watch.busy() is None
+
+
 def test_the_run_queue_counts_a_running_child(child):
     from pybullet_gazebo.ros.idle_threads import RunQueue
     queue = RunQueue()

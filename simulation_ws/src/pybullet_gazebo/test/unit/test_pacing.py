@@ -98,6 +98,41 @@ def test_disabled_or_forgotten_lockstep_never_waits():
     assert lock.settle() and time.monotonic() - start < 0.1 and told == []
 
 
+class QuickWatch(FakeWatch):
+    """A FakeWatch whose idle_now() answers as IdleWatch's: only a quick look, counted."""
+
+    def __init__(self, idle_at=0.0):
+        super().__init__(idle_at)
+        self.quick_looks = 0
+
+    def idle_now(self):
+        self.quick_looks += 1
+        return self.busy() is None
+
+
+def test_settled_now_never_waits_and_settles_once_idle():
+    watch = QuickWatch(idle_at=time.monotonic() + 0.2)
+    lock, told = make(watch, timeout=5.0)
+    assert lock.settled_now() and watch.quick_looks == 0       # nothing sent: no look
+    lock.sending()
+    start = time.monotonic()
+    assert not lock.settled_now() and time.monotonic() - start < 0.05
+    assert lock.unsettled and lock.stats.settles == 0
+    time.sleep(0.25)
+    assert lock.settled_now() and not lock.unsettled
+    assert (lock.stats.settles, lock.stats.waits, lock.stats.wall_waiting) == (1, 0, 0.0)
+    assert lock.settle() and lock.stats.settles == 1          # nothing left to wait for
+    assert told == []
+
+
+def test_the_summary_counts_ticks_handed_on_while_stepping():
+    lock, _ = make(FakeWatch())
+    assert "ticks" not in lock.stats.summary()
+    lock.stats.ticks, lock.stats.ticks_while_stepping = 20, 17
+    assert "17 of 20 /clock ticks to a loop node handed on while physics ran" in \
+        lock.stats.summary()
+
+
 def test_pacer_holds_the_real_time_factor():
     pacer = RealTimePacer(real_time_factor=2.0, sim_time=0.0)
     start = time.monotonic()

@@ -417,6 +417,15 @@ class IdleWatch:
             return "self", None
         return self._second_look()
 
+    def idle_now(self):
+        """True when every watched process is idle now, by a quick look only: False, without
+        a look at the threads, when the machine runs anything but the caller (a whole look
+        costs as much as the stretch of physics a caller would fit it between)."""
+        if self.run_queue.runnable() != 1 or self._spinning() or self.backlog.packets():
+            return False
+        self._round_start = time.monotonic()
+        return self._confirm_quick_look() is None
+
     def _first_busy(self, look):
         """(pid, tid) of the first process in which `look(process)` finds a thread at work,
         or None; processes it finds gone (False) are dropped."""

@@ -60,10 +60,15 @@ class LockstepStats:
         self.wall_waiting = 0.0     # [s] wall spent in those waits
         self.stepped_past = {}      # who was still at work at a timeout -> times
         self.waited_for = {}        # who was at work when a wait began -> [s] wall waited
+        self.ticks_while_stepping = 0   # /clock ticks handed on while physics ran on
+        self.ticks = 0                  # /clock ticks handed on to a loop node in all
 
     def summary(self):
         text = ("%d waits for the controllers (of %d settles), %.1f s of wall time waiting, "
                 "%d time-outs" % (self.waits, self.settles, self.wall_waiting, self.timeouts))
+        if self.ticks:
+            text += ", %d of %d /clock ticks to a loop node handed on while physics ran" % (
+                self.ticks_while_stepping, self.ticks)
         if self.stepped_past:
             text += " (still at work: %s)" % ", ".join(
                 "%s %d x" % item for item in sorted(self.stepped_past.items()))
@@ -104,6 +109,19 @@ class Lockstep:
     def forget(self):
         """A reset: nothing sent is waited for any more."""
         self._sent = False
+
+    def settled_now(self):
+        """Without waiting: True when the loop nodes are done with what they were sent (as
+        settle() would find at once), False when someone may still be at work. The look is
+        taken only when the machine runs nothing but the caller (IdleWatch.idle_now): it is
+        for the loop's steps between two looks, which must stay cheap."""
+        if not self._sent:
+            return True
+        if not self.watch.idle_now():
+            return False
+        self.stats.settles += 1
+        self._sent = False
+        return True
 
     def settle(self):
         """Waits until the loop nodes are done with what they were sent. False when physics

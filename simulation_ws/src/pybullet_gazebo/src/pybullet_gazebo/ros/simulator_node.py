@@ -90,7 +90,9 @@ class SimulatorNode:
                 "lockstep: %s was still at work %.2f s after it was sent a message; stepping "
                 "on (lockstep_timeout; counted in the run summary)" % (who,
                                                                      params.lockstep_timeout)))
-        self._loop_clock = None                   # lockstep: /clock the loop nodes still owe
+        self._loop_clock = None                   # lockstep: /clock the loop nodes are owed
+        self._owed = None                         # ... the nodes still owed it, in name order
+        self._handed_on = False                   # ... a tick went out inside this stretch
         self._watched_key = None                  # lockstep: the loop connections watched now
         self._watched_names = set()               # ... and their nodes
         self._bindings = {}                       # robot name -> RobotBindings
@@ -185,7 +187,8 @@ class SimulatorNode:
                 self.world.reset_world()
             self.pacer.restart(self.world.sim_time)
             self.lockstep.forget()
-            self._loop_clock = None
+            self._loop_clock = self._owed = None
+            self._handed_on = False
 
     # --- the loop -------------------------------------------------------------------------
     def run(self):
@@ -225,10 +228,12 @@ class SimulatorNode:
             with self.lock:
                 if self.paused:                   # paused (or reset) while we waited
                     continue
-                readings = self.world.advance(self._steps_ahead(), until_news=True)
+                readings = self._advance()
                 now = self.world.sim_time
-            # lockstep: the loop nodes are done with what they had before they get more
-            if lockstep and (readings or self._clock_due(force=False, peek=True)) \
+            # lockstep: the loop nodes are done with what they had before they get more, and
+            # with a tick handed on inside the stretch before anything else happens
+            if lockstep and (readings or self._handed_on
+                             or self._clock_due(force=False, peek=True)) \
                     and not self._settle_loop_nodes():
                 continue
             with self.lock:
@@ -242,28 +247,68 @@ class SimulatorNode:
         needed_at = self.world.next_command_time()
         return needed_at is not None and self.world.sim_time >= needed_at
 
+    def _advance(self):
+        """Physics up to the next news (World.advance until_news) or the step before a drive
+        reads its command. Call with the world's lock held.
+
+        Lockstep, while the loop nodes are owed a /clock tick: step by step, and each loop
+        node gets its tick (in name order) as soon as a look between two steps finds them all
+        done with the readings. Its rospy.Rate loop then acts while physics runs on: what it
+        sees is the same (nothing is published inside the stretch, the tick's sim time is
+        that of the readings) and its command is read at the same drive update, as when the
+        tick went out at the stretch's end. The lock stays held to the stretch's end and the
+        loop settles there, so a service call the tick makes is served at that step whatever
+        the machine's speed; no model_states step ends the stretch (their wall-time limit
+        would make where it ends the machine's choice): they are published inside it."""
+        world = self.world
+        if not (self.lockstep.enabled and self._loop_clock is not None):
+            return world.advance(self._steps_ahead(), until_news=True)
+        ahead = self._steps_ahead(model_states=False)
+        changes = world.contacts.changes
+        self._watch_loop_nodes()
+        for left in range(ahead, 0, -1):
+            readings = world.advance(1, until_news=True, continues=left < ahead,
+                                     horizon=left)
+            if readings or left == 1 or world.contacts.changes != changes:
+                return readings
+            if self._model_states_due():
+                self.state_topics.publish()
+            if self._loop_clock is not None and self.lockstep.settled_now():
+                self._hand_on_tick()
+                self._handed_on = True
+                self.lockstep.stats.ticks_while_stepping += 1
+        return []
+
     def _settle_loop_nodes(self):
         """Lockstep: waits until the loop nodes are done with what they were sent, then
-        sends them the /clock tick they still owe (that of the readings they just took in:
-        after them, so that a rospy.Rate loop it wakes reads them), to one node at a time,
-        waiting for each. False when physics was paused meanwhile."""
+        sends them the /clock tick they are still owed (that of the readings they just took
+        in: after them, so that a rospy.Rate loop it wakes reads them), to one node at a
+        time, waiting for each. False when physics was paused meanwhile."""
         if not (self.lockstep.unsettled or self._loop_clock is not None):
             return True
         self._watch_loop_nodes()
-        if not self.lockstep.settle():
+        settled = self.lockstep.settle()
+        if not settled:
             return False
-        if self._loop_clock is None:
-            return True
-        # one loop node at a time, in the order of their names: when one node's tick acts on
-        # another (bug 2 switching go to point on by a service call), which ticks first is
-        # then the same on every run, not the machine's choice
-        stamp, self._loop_clock = self._loop_clock, None
-        settled = True
-        for node in sorted(self._watched_names):
-            self.lockstep.sending()
-            self.clock_pub.publish_to_loop_nodes(stamp, {node})
+        self._handed_on = False
+        while self._loop_clock is not None:
+            self._hand_on_tick()
             settled = self.lockstep.settle() and settled
         return settled
+
+    def _hand_on_tick(self):
+        """The owed /clock tick to the next loop node that has not had it. One node at a
+        time, in the order of their names: when one node's tick acts on another (bug 2
+        switching go to point on by a service call), which ticks first is then the same on
+        every run, not the machine's choice."""
+        if self._owed is None:
+            self._owed = sorted(self._watched_names)
+        if self._owed:
+            self.lockstep.sending()
+            self.lockstep.stats.ticks += 1
+            self.clock_pub.publish_to_loop_nodes(self._loop_clock, {self._owed.pop(0)})
+        if not self._owed:
+            self._loop_clock = self._owed = None
 
     def _watch_loop_nodes(self):
         """Lockstep watches the processes of the loop nodes. Their ids are asked again
@@ -304,7 +349,7 @@ class SimulatorNode:
             return "pid %s" % pid
         return "%s%s (pid %d)" % ("node " if names[0].startswith("/") else "", names[0], pid)
 
-    def _steps_ahead(self):
+    def _steps_ahead(self, model_states=True):
         """How many physics steps the loop may take in one World.advance (which stops early
         at readings or a change of touches): up to the next /clock tick, model_states
         message, or step before which lockstep may wait for an answer; one at a time when
@@ -319,7 +364,7 @@ class SimulatorNode:
         ahead = MAX_STEPS_AHEAD
         if self.clock_pub is not None:
             ahead = min(ahead, self._clock_every - (world.step_count - self._last_clock_step))
-        if self.state_topics.wanted():
+        if model_states and self.state_topics.wanted():
             ahead = min(ahead, self._model_states_every
                         - world.step_count % self._model_states_every)
         needed_at = world.next_command_time() if self.lockstep.enabled else None
@@ -340,8 +385,7 @@ class SimulatorNode:
         of scans published."""
         touching = self.world.touching() if self.contacts_pub is not None else []
         contacts_changed = touching != self._last_touching
-        model_states_due = self.world.step_count % self._model_states_every == 0 \
-            and self.state_topics.heard()                          # costly: only if heard
+        model_states_due = self._model_states_due()
         clock_due = self._clock_due(force=bool(readings))
         if not (readings or contacts_changed or model_states_due or clock_due):
             return 0
@@ -364,6 +408,12 @@ class SimulatorNode:
         if model_states_due:
             self.state_topics.publish()
         return scans
+
+    def _model_states_due(self):
+        """model_states (and link_states) are due after this step and someone hears them
+        (building them is costly: only then)."""
+        return self.world.step_count % self._model_states_every == 0 \
+            and self.state_topics.heard()
 
     def _clock_due(self, force, peek=False):
         """/clock every _clock_every steps and on each step with readings (`force`), counted
