@@ -3,8 +3,9 @@
 #   scripts/bench.sh [--seconds 15] [--soak MINUTES] [--clock-hz 20] [--output output/]
 #   scripts/bench.sh --listeners-only ROUNDS [--seconds 15] [--watch-rate HZ]
 #     only the lockstep loop without and with listeners, in turn (ratio per round, median)
-#   scripts/bench.sh --loop-program-only [--seconds 15]
-#     obstacle_avoidance.py and the same rules on a rospy.Rate loop, in lockstep: their ratio
+#   scripts/bench.sh --loop-program-only [ROUNDS] [--seconds 15]
+#     obstacle_avoidance.py and the same rules on a rospy.Rate loop, in lockstep, in turn
+#     ROUNDS times (default 3) at /clock 20 and 100 Hz: their ratio per round, median
 #   scripts/bench.sh --bug [--worlds world02 world03] [--output output/]
 #     the series' bug-2 runs in lockstep (m2wr_tools.bench_bug): x real time, lockstep
 #     time-outs, contact events

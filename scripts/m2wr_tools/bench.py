@@ -3,7 +3,7 @@ obstacle_avoidance.py), printed side by side and written to <output>/bench.json.
 
   scripts/bench.sh [--seconds 15] [--soak MINUTES] [--clock-hz 20] [--output output/]
   scripts/bench.sh --listeners-only ROUNDS [--seconds 15] [--watch-rate HZ]
-  scripts/bench.sh --loop-program-only [--seconds 15]
+  scripts/bench.sh --loop-program-only [ROUNDS] [--seconds 15]
 
 Figures:
   whole loop        real-time factor of simulator + obstacle_avoidance.py, headless, with
@@ -17,6 +17,10 @@ Figures:
                     demo's /clock rate (the batch runner's) and at the simulator's default
                     100 Hz (the world launch's): its x real time over obstacle_avoidance.py's
                     at the same clock (target >= 0.8)
+  --loop-program-only  just obstacle_avoidance.py and the loop program in lockstep, in turn,
+                    ROUNDS times (default 3) at each of the two clock rates: each round's
+                    ratio and the median (the machine's speed drifts between two
+                    measurements; in turn, a round's two see the same machine)
   lockstep check    scans published vs cmd_vel answers over a window that starts and ends
                     paused (so no answer is in flight at either edge)
   physics alone     the engine only (no ROS), world02 + m2wr: Bullet's stepSimulation, and
@@ -210,6 +214,49 @@ def loop_program_ratios(loops):
     return ratios
 
 
+def loop_program_rounds(session, listener, args):
+    """--loop-program-only: obstacle_avoidance.py and the loop program in lockstep, in turn,
+    at --clock-hz and at the simulator's default; [{clock label: {"answering": result,
+    "loop": result, "load": ...}}] one dict per round."""
+    rounds = []
+    for index in range(args.loop_program_only):
+        say("round %d of %d" % (index + 1, args.loop_program_only))
+        pairs = {}
+        for clock_hz in sorted({args.clock_hz, SIMULATOR_DEFAULT_CLOCK_HZ}):
+            label = "/clock %g Hz" % clock_hz
+            pairs[label] = {
+                "answering": measure_loop(session, listener, "lockstep, " + label, True,
+                                          clock_hz, args.seconds, args.check_seconds),
+                "loop": measure_loop(session, listener, "lockstep, %s, %s" % (label, LOOP),
+                                     True, clock_hz, args.seconds, args.check_seconds,
+                                     controller=LOOP_PROGRAM),
+                "load": "%.2f" % os.getloadavg()[0]}
+        rounds.append(pairs)
+    return rounds
+
+
+def loop_program_report(figures):
+    lines = ["", "loop program / obstacle_avoidance.py in lockstep, round by round (load before "
+             "%s; target >= 0.8):" % figures["machine"]["load_before"]]
+    rounds = figures["loop_program_rounds"]
+    for label in (rounds[0] if rounds else {}):
+        ratios = []
+        for index, pairs in enumerate(rounds):
+            answering = pairs[label]["answering"]["x_real_time"]
+            loop = pairs[label]["loop"]["x_real_time"]
+            ratio = loop / answering if answering and loop else None
+            if ratio is not None:
+                ratios.append(ratio)
+            lines.append("  %s, round %d: %s / %s = %s; load %s" % (
+                label, index + 1, fmt(loop, "%.1fx"), fmt(answering, "%.1fx"),
+                fmt(ratio, "%.2f"),
+                pairs[label]["load"]))
+        if ratios:
+            lines.append("  %s: median %.2f, lowest %.2f" % (label, statistics.median(ratios),
+                                                            min(ratios)))
+    return "\n".join(lines)
+
+
 def listener_rounds(session, listener, args):
     """--listeners-only: the lockstep loop without and with listeners, in turn."""
     extra = () if args.watch_rate is None else ("watch_rate:=%g" % args.watch_rate,)
@@ -263,9 +310,11 @@ def parse_args(argv):
                         help="only the lockstep loop without and with listeners, ROUNDS times "
                              "in turn (the listener target's ratio per round and its median); "
                              "no engine, free-running or launch figures")
-    parser.add_argument("--loop-program-only", action="store_true",
-                        help="only obstacle_avoidance.py and the loop program in lockstep, at "
-                             "--clock-hz and at 100 Hz, and their ratios (issue 26's target)")
+    parser.add_argument("--loop-program-only", type=int, nargs="?", const=3, default=0,
+                        metavar="ROUNDS",
+                        help="only obstacle_avoidance.py and the loop program in lockstep, in "
+                             "turn, ROUNDS times (default 3) at --clock-hz and at 100 Hz: each "
+                             "round's ratio and the median (target >= 0.8)")
     parser.add_argument("--watch-rate", type=float, default=None, metavar="HZ",
                         help="with --listeners-only: the simulator's ~watch_rate (default: its "
                              "own, 30)")
@@ -277,6 +326,10 @@ def parse_args(argv):
             parser.error("--%s must be a number > 0" % name.replace("_", "-"))
     if args.listeners_only < 0:
         parser.error("--listeners-only must be a number of rounds >= 1")
+    if args.loop_program_only < 0:
+        parser.error("--loop-program-only must be a number of rounds >= 1")
+    if args.loop_program_only and args.listeners_only:
+        parser.error("--loop-program-only and --listeners-only: one at a time")
     if args.watch_rate is not None and not (math.isfinite(args.watch_rate)
                                             and args.watch_rate >= 0):
         parser.error("--watch-rate must be a number of Hz >= 0 (0: no limit)")
@@ -317,13 +370,7 @@ def main(argv=None):
         if args.listeners_only:
             figures["listener_rounds"] = listener_rounds(session, listener, args)
         elif args.loop_program_only:
-            loops = figures["loop"]
-            for clock_hz in sorted({args.clock_hz, SIMULATOR_DEFAULT_CLOCK_HZ}):
-                name = "lockstep" if clock_hz == args.clock_hz else "lockstep /clock %g Hz" \
-                    % clock_hz
-                loops[name] = measure_loop(session, listener, name, True, clock_hz,
-                                           args.seconds, args.check_seconds)
-            loop_program_columns(session, listener, args, loops)
+            figures["loop_program_rounds"] = loop_program_rounds(session, listener, args)
         else:
             whole_bench(session, listener, args, figures)
 
@@ -341,13 +388,8 @@ def main(argv=None):
         print(rounds_report(figures), flush=True)
     if "engine" in figures:
         print(report(figures) if figures["loop"] else "", flush=True)
-    elif args.loop_program_only:
-        for label, ratio in loop_program_ratios(figures["loop"]):
-            print("loop program / obstacle_avoidance.py, %s: %s x real time / %s = %s "
-                  "(target >= 0.8)" % (label, fmt(figures["loop"][label + ", " + LOOP]
-                                                 ["x_real_time"]),
-                                       fmt(figures["loop"][label]["x_real_time"]),
-                                       fmt(ratio, "%.2f")), flush=True)
+    elif figures.get("loop_program_rounds"):
+        print(loop_program_report(figures), flush=True)
     say("figures written to %s" % path)
     return status
 

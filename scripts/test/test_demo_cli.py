@@ -49,6 +49,28 @@ def test_bench_options():
         bench.parse_args(["--seconds", "0"])
 
 
+def test_bench_loop_program_rounds_option_and_report():
+    assert bench.parse_args(["--loop-program-only"]).loop_program_only == 3
+    assert bench.parse_args(["--loop-program-only", "5"]).loop_program_only == 5
+    with pytest.raises(SystemExit):
+        bench.parse_args(["--loop-program-only", "-1"])
+    with pytest.raises(SystemExit):
+        bench.parse_args(["--loop-program-only", "2", "--listeners-only", "2"])
+
+    def pair(loop, answering):
+        return {"loop": {"x_real_time": loop}, "answering": {"x_real_time": answering},
+                "load": "0.50"}
+    figures = {"machine": {"load_before": "0.20"}, "loop_program_rounds": [
+        {"/clock 20 Hz": pair(45.0, 50.0), "/clock 100 Hz": pair(20.0, 25.0)},
+        {"/clock 20 Hz": pair(40.0, 50.0), "/clock 100 Hz": pair(24.0, 24.0)},
+        {"/clock 20 Hz": pair(49.0, 50.0), "/clock 100 Hz": pair(None, 24.0)}]}
+    lines = bench.loop_program_report(figures).splitlines()
+    assert "  /clock 20 Hz, round 2: 40.0x / 50.0x = 0.80; load 0.50" in lines
+    assert "  /clock 20 Hz: median 0.90, lowest 0.80" in lines
+    assert "  /clock 100 Hz, round 3: n/a / 24.0x = n/a; load 0.50" in lines
+    assert "  /clock 100 Hz: median 0.90, lowest 0.80" in lines
+
+
 def test_problem_lines_pick_the_error_without_colour_codes():
     log = ("\x1b[1mstarted roslaunch server\x1b[0m\n"
            "gazebo_world: world 'world99' not found; pass world:=NAME with NAME one of world01, world02\n"

@@ -17,7 +17,10 @@ clock_topic.py for who they are), and before it sends the next thing or steps in
 update it calls `settle`, which waits until the loop nodes' processes and the simulator's own
 readers are idle (idle_threads.py, own_receivers.py): done with what they got, their answers
 (commands, service calls) in. A controller that is idle and published nothing has nothing to
-say this tick: lockstep does not wait for a command that will not come.
+say this tick: lockstep does not wait for a command that will not come. Physics runs on while
+a controller acts, up to the next thing it could change: a /clock tick owed to a rospy.Rate
+loop is handed on between two steps as soon as a look that never waits (`settled_now`) finds
+the loop nodes done with the readings (SimulatorNode._advance).
 
 What it cannot promise: a node on another machine cannot be watched (it is named in the run
 summary); a thread that computes for longer than idle_threads.SPIN_CPU of CPU at once is
