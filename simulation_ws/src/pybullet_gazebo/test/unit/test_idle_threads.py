@@ -203,14 +203,15 @@ def test_idle_now_never_finds_a_busy_child_idle_and_never_waits(child):
     """The loop's look between two physics steps (lockstep hands a /clock tick on when it
     says idle): while the child computes it answers False at once, whatever the machine
     runs; once the child sleeps in its read, a quiet machine lets it answer True."""
-    worker = child(WORKER, "0.08")                 # (under SPIN_WALL: no busy loop)
+    worker = child(WORKER, "0.03")                 # (well under SPIN_WALL: no busy loop,
+                                                   # even on a loaded machine)
     watch = IdleWatch()
     watch.watch([worker.pid])
     assert settle(watch) is None
     watch.note_sent()
     worker.stdin.write("1\n")
     worker.stdin.flush()
-    time.sleep(0.01)                               # it computes for 0.08 s of CPU now
+    time.sleep(0.005)                              # it computes for 0.03 s of CPU now
     start = time.monotonic()
     for _ in range(20):
         assert not watch.idle_now()
