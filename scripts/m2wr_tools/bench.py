@@ -249,8 +249,7 @@ def loop_program_report(figures):
                 ratios.append(ratio)
             lines.append("  %s, round %d: %s / %s = %s; load %s" % (
                 label, index + 1, fmt(loop, "%.1fx"), fmt(answering, "%.1fx"),
-                fmt(ratio, "%.2f"),
-                pairs[label]["load"]))
+                fmt(ratio, "%.2f"), pairs[label]["load"]))
         if ratios:
             lines.append("  %s: median %.2f, lowest %.2f" % (label, statistics.median(ratios),
                                                             min(ratios)))

@@ -408,7 +408,7 @@ class IdleWatch:
         packets = self.backlog.packets()
         if packets:
             return "kernel", packets
-        if self.run_queue.runnable() == 1 and not self._spinning():   # the quick look
+        if self._quick_look_holds():
             return self._confirm_quick_look()
         busy = self._first_busy(lambda p: p.busy_thread(now, self._round_start))
         if busy is not None:
@@ -421,10 +421,15 @@ class IdleWatch:
         """True when every watched process is idle now, by a quick look only: False, without
         a look at the threads, when the machine runs anything but the caller (a whole look
         costs as much as the stretch of physics a caller would fit it between)."""
-        if self.run_queue.runnable() != 1 or self._spinning() or self.backlog.packets():
+        if not self._quick_look_holds() or self.backlog.packets():
             return False
         self._round_start = time.monotonic()
         return self._confirm_quick_look() is None
+
+    def _quick_look_holds(self):
+        """Whether the quick look may stand for both looks (see the module docstring): the
+        machine runs nothing but the caller, and no busy loop is known."""
+        return self.run_queue.runnable() == 1 and not self._spinning()
 
     def _first_busy(self, look):
         """(pid, tid) of the first process in which `look(process)` finds a thread at work,
