@@ -1,7 +1,13 @@
 #!/usr/bin/env python3
 """rostest: facing a wall, the tutorial's obstacle_avoidance.py turns m2wr LEFT, and the robot
 clears the wall. Fixture worlds/wall_ahead_2p5.world: the wall's face is x = 2.5 m for
-y -4 .. 4; m2wr starts at the origin facing +x.
+y -4 .. 4; m2wr starts at the origin heading START_YAW (0.1 rad) left of +x, the wall's normal.
+
+Head-on (yaw 0) the test would judge the laser noise, not the program: the robot runs on a few
+cm past the 1 m mark, the fleft and fright regions (nearest points 18 deg either side of the
+heading) both fall under 1 m, and the noise picks which falls first; 3 of 33 runs on 27 Nov
+turned right. At START_YAW, fright's nearest point is 1.024 d away and fleft's 1.092 d (d the
+laser's distance to the wall), so the geometry picks fright, and the program must turn left.
 
 The tutorial's program answers "case 2 - front" (and cases 3, 5, 7, 8) with angular.z = -0.3
 and says the robot turns left: on m2wr, whose joint named "right" is on its left, a negative
@@ -27,6 +33,7 @@ from pybullet_gazebo.ros.testing import (ContactLog, NodeLog, unwrap_angle, wait
 WALL_X = 2.5                 # [m] the wall's face
 SENSOR_AHEAD = 0.15          # [m] laser ahead of the chassis frame
 THRESHOLD = 1.0              # [m] the program's "something there" distance
+START_YAW = 0.1             # [rad] spawn heading (turn_left_at_wall.test)
 CASE_LINE = re.compile(r"case (\d) - ")
 
 
@@ -87,32 +94,34 @@ class TurnLeftAtWallTest(unittest.TestCase):
 
     def test_1_drives_up_to_the_wall_and_sees_it_in_front(self):
         t0, first = self.wall_seen()
-        self.assertEqual(first, 2, "first case off the straight run: %s" % self.case_runs())
+        # front alone, or front and fright (nearer than fleft at START_YAW): both turn left
+        self.assertIn(first, (2, 5), "first case off the straight run: %s" % self.case_runs())
         _, x, y, yaw, _ = self.odom_at(t0)
         laser_to_wall = WALL_X - (x + SENSOR_AHEAD * math.cos(yaw))
         self.assertAlmostEqual(laser_to_wall, THRESHOLD, delta=0.1,
                                msg="the program should see the wall at 1 m (robot at %.2f, %.2f)"
                                % (x, y))
-        self.assertAlmostEqual(yaw, 0.0, delta=0.03, msg="it drove straight up to the wall")
+        self.assertAlmostEqual(yaw, START_YAW, delta=0.03, msg="it drove straight up to the wall")
 
     def test_2_turns_left_at_the_wall(self):
         t0, _ = self.wall_seen()
         t1 = self.back_in_case_1(t0)
         yaws = [o[3] for o in self.odom if t0 <= o[0] <= (t1 or self.end)]
-        print("FIGURES turned left by %.1f deg from %.2f s to %s s" % (
-            math.degrees(yaws[-1] - yaws[0]), t0 - self.start,
+        print("FIGURES turned left by %.1f deg to a heading of %.1f deg from %.2f s to %s s" % (
+            math.degrees(yaws[-1] - yaws[0]), math.degrees(yaws[-1]), t0 - self.start,
             "%.2f" % (t1 - self.start) if t1 else "the end"))
         self.assertGreaterEqual(min(yaws), yaws[0] - 0.02,
                                 "turned right (clockwise) at the wall: yaw fell from %.3f to "
                                 "%.3f rad" % (yaws[0], min(yaws)))
-        # measured 44-50 deg (27 Nov, three runs; the controller starts while the world
-        # runs, so where its ticks fall differs): since the caster drags as in Gazebo (mu 1),
-        # the turn's last tick lands a few degrees either side of 45
-        self.assertGreater(yaws[-1] - yaws[0], math.radians(35),
-                           "turned left by %.1f deg only%s"
-                           % (math.degrees(yaws[-1] - yaws[0]), "" if t1 else ", and stayed"))
+        # the program turns until front and fright are clear, so the heading it leaves the turn
+        # on is the geometry's: measured 40-49 deg (turned by 34-43 from START_YAW; 27 Nov, 12
+        # runs; the controller starts while the world runs, so where its ticks fall differs)
+        self.assertGreater(yaws[-1], math.radians(30),
+                           "turned left to a heading of %.1f deg only (by %.1f deg)%s"
+                           % (math.degrees(yaws[-1]), math.degrees(yaws[-1] - yaws[0]),
+                              "" if t1 else ", and stayed"))
         self.assertIsNotNone(t1, "never back in case 1 after the wall: runs %s" % self.case_runs())
-        self.assertGreaterEqual(min(o[3] for o in self.odom), -0.05,
+        self.assertGreaterEqual(min(o[3] for o in self.odom), START_YAW - 0.05,
                                 "the robot turned right (clockwise) at some point")
 
     def test_3_clears_the_wall_without_touching_it(self):
