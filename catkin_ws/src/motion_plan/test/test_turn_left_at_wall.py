@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """rostest: facing a wall, the tutorial's obstacle_avoidance.py turns m2wr LEFT, and the robot
 clears the wall. Fixture worlds/wall_ahead_2p5.world: the wall's face is x = 2.5 m for
-y -4 .. 4; m2wr starts at the origin heading START_YAW (0.1 rad) left of +x, the wall's normal.
+y -4 .. 4; m2wr starts at the origin heading ~start_yaw (0.1 rad in turn_left_at_wall.test)
+left of +x, the wall's normal.
 
 Head-on (yaw 0) the test would judge the laser noise, not the program: the robot runs on a few
 cm past the 1 m mark, the fleft and fright regions (nearest points 18 deg either side of the
 heading) both fall under 1 m, and the noise picks which falls first; 3 of 33 runs on 27 Nov
-turned right. At START_YAW, fright's nearest point is 1.024 d away and fleft's 1.092 d (d the
+turned right. At 0.1 rad, fright's nearest point is 1.024 d away and fleft's 1.092 d (d the
 laser's distance to the wall), so the geometry picks fright, and the program must turn left.
 
 The tutorial's program answers "case 2 - front" (and cases 3, 5, 7, 8) with angular.z = -0.3
@@ -16,7 +17,7 @@ the other way would send it into oscillation or into the wall; this test catches
 
 Watches /odom (yaw unwrapped, speed), /rosout lines of node /reading_laser ("case N - ...")
 and the latched /gazebo/contacts, for ~duration [s sim] (25) from the first /odom;
-~wall_timeout [s wall] (60).
+~wall_timeout [s wall] (60); ~start_yaw [rad] is the heading the launch spawned m2wr at.
 """
 import math
 import re
@@ -33,7 +34,6 @@ from pybullet_gazebo.ros.testing import (ContactLog, NodeLog, unwrap_angle, wait
 WALL_X = 2.5                 # [m] the wall's face
 SENSOR_AHEAD = 0.15          # [m] laser ahead of the chassis frame
 THRESHOLD = 1.0              # [m] the program's "something there" distance
-START_YAW = 0.1             # [rad] spawn heading (turn_left_at_wall.test)
 CASE_LINE = re.compile(r"case (\d) - ")
 
 
@@ -43,6 +43,7 @@ class TurnLeftAtWallTest(unittest.TestCase):
         rospy.init_node("test_turn_left_at_wall")
         duration = rospy.get_param("~duration", 25.0)
         wall_timeout = rospy.get_param("~wall_timeout", 60.0)
+        cls.start_yaw = rospy.get_param("~start_yaw")
         cls.lock = threading.Lock()
         cls.received = []              # (sim time [s], x [m], y [m], unwrapped yaw [rad], v [m/s])
         cls.program_log = NodeLog("/reading_laser")
@@ -94,14 +95,15 @@ class TurnLeftAtWallTest(unittest.TestCase):
 
     def test_1_drives_up_to_the_wall_and_sees_it_in_front(self):
         t0, first = self.wall_seen()
-        # front alone, or front and fright (nearer than fleft at START_YAW): both turn left
+        # front alone, or front and fright (nearer than fleft at ~start_yaw): both turn left
         self.assertIn(first, (2, 5), "first case off the straight run: %s" % self.case_runs())
         _, x, y, yaw, _ = self.odom_at(t0)
         laser_to_wall = WALL_X - (x + SENSOR_AHEAD * math.cos(yaw))
         self.assertAlmostEqual(laser_to_wall, THRESHOLD, delta=0.1,
                                msg="the program should see the wall at 1 m (robot at %.2f, %.2f)"
                                % (x, y))
-        self.assertAlmostEqual(yaw, START_YAW, delta=0.03, msg="it drove straight up to the wall")
+        self.assertAlmostEqual(yaw, self.start_yaw, delta=0.03,
+                               msg="it drove straight up to the wall")
 
     def test_2_turns_left_at_the_wall(self):
         t0, _ = self.wall_seen()
@@ -114,14 +116,14 @@ class TurnLeftAtWallTest(unittest.TestCase):
                                 "turned right (clockwise) at the wall: yaw fell from %.3f to "
                                 "%.3f rad" % (yaws[0], min(yaws)))
         # the program turns until front and fright are clear, so the heading it leaves the turn
-        # on is the geometry's: measured 40-49 deg (turned by 34-43 from START_YAW; 27 Nov, 12
+        # on is the geometry's: measured 40-49 deg (turned by 34-43 from the start; 27 Nov, 12
         # runs; the controller starts while the world runs, so where its ticks fall differs)
         self.assertGreater(yaws[-1], math.radians(30),
                            "turned left to a heading of %.1f deg only (by %.1f deg)%s"
                            % (math.degrees(yaws[-1]), math.degrees(yaws[-1] - yaws[0]),
                               "" if t1 else ", and stayed"))
         self.assertIsNotNone(t1, "never back in case 1 after the wall: runs %s" % self.case_runs())
-        self.assertGreaterEqual(min(o[3] for o in self.odom), START_YAW - 0.05,
+        self.assertGreaterEqual(min(o[3] for o in self.odom), self.start_yaw - 0.05,
                                 "the robot turned right (clockwise) at some point")
 
     def test_3_clears_the_wall_without_touching_it(self):
