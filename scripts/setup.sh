@@ -102,6 +102,18 @@ else
     || fail "pip could not install scripts/ (m2wr_tools) into the venv"
 fi
 
+STEP="lockstep hook"
+# Every interpreter of the venv loads lockstep's handshake into rospy once a program imports it
+# (simulation_ws/src/pybullet_gazebo/src/pybullet_gazebo/ros/lockstep/autoload.py): the
+# tutorial's and the series' programs report to the simulator unchanged. Outside the project's
+# environment (no catkin workspace on PYTHONPATH) the line does nothing.
+site="$("$VENV/bin/python" -c "import sysconfig; print(sysconfig.get_paths()['purelib'])")"
+hook="import os; os.environ.get('LOCKSTEP_HANDSHAKE', 'on') == 'off' or exec('try:\\n import pybullet_gazebo.ros.lockstep.autoload\\nexcept ImportError:\\n pass')"
+if [ "$(cat "$site/m2wr_lockstep.pth" 2>/dev/null)" != "$hook" ]; then
+  say "3/4 lockstep hook: writing $site/m2wr_lockstep.pth"
+  printf '%s\n' "$hook" > "$site/m2wr_lockstep.pth"
+fi
+
 STEP="catkin build"
 export PATH="$VENV/bin:$PATH"        # catkin_make must find the venv's python3, not pyenv's
 unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH

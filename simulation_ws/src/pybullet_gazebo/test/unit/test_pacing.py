@@ -32,9 +32,11 @@ class FakeWatch:
 
 
 def make(watch, enabled=True, timeout=0.5, paused=lambda: False):
+    """A Lockstep whose one controller sends no reports: it is watched (the fallback)."""
     told = []
-    lock = Lockstep(enabled, timeout, watch, is_shutdown=lambda: False, is_paused=paused,
+    lock = Lockstep(enabled, timeout, None, watch, is_shutdown=lambda: False, is_paused=paused,
                     describe=lambda busy: "pid %d" % busy[0], on_timeout=told.append)
+    lock.wait_for(reporting=(), watched={"/no_reports"})
     return lock, told
 
 

@@ -32,6 +32,7 @@ import time
 import pybullet
 import rospy
 from gazebo_msgs.msg import ContactState, ContactsState
+from lockstep_msgs.msg import LockstepReport
 from tf2_msgs.msg import TFMessage
 from pybullet_gazebo.engine.client import Client
 
@@ -43,6 +44,9 @@ from pybullet_gazebo.ros.clock_topic import ClockTopic
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.idle_threads import IdleWatch
+from pybullet_gazebo.ros.lockstep import REPORT_TOPIC, rospy_hooks
+from pybullet_gazebo.ros.lockstep.board import Board
+from pybullet_gazebo.ros.lockstep.service_providers import ServiceProviders
 from pybullet_gazebo.ros.node_processes import MASTER, NodeProcesses
 from pybullet_gazebo.ros.own_receivers import OwnReceivers
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
@@ -79,8 +83,17 @@ class SimulatorNode:
         self._node_processes = NodeProcesses(rospy.get_name())
         self._busy_loops = set()            # lockstep: threads taken for busy loops (named)
         own_receivers = OwnReceivers()
+        self.board = self._report_sub = None
+        if params.lockstep:
+            # the handshake: the simulator's own counts (never reported) against each
+            # controller's reports (lockstep/)
+            own = rospy_hooks.install(report=False)
+            self.board = Board(rospy.get_name(), own.counts, ServiceProviders(rospy.get_name()))
+            own.on_change = self.board.notify
+            self._report_sub = rospy.Subscriber(REPORT_TOPIC, LockstepReport, self._on_report,
+                                                queue_size=None)
         self.lockstep = Lockstep(
-            params.lockstep, params.lockstep_timeout,
+            params.lockstep, params.lockstep_timeout, self.board,
             IdleWatch(own_busy=own_receivers.busy, own_moved=own_receivers.moved,
                       on_spin=self._note_busy_loop)
             if params.lockstep else None,
@@ -311,21 +324,50 @@ class SimulatorNode:
             self._loop_clock = self._owed = None
 
     def _watch_loop_nodes(self):
-        """Lockstep watches the processes of the loop nodes. Their ids are asked again
-        whenever the loop nodes' connections change: a node restarted under the same name
-        (the batch runner's next controller) is a new process."""
+        """Lockstep waits for the loop nodes: by their reports when they send them (the
+        handshake), by the /proc watch of their processes otherwise. Both are asked again
+        whenever the loop nodes' connections change (a node restarted under the same name,
+        the batch runner's next controller, is a new process) or a node starts reporting."""
         connections = [pair for b in list(self._bindings.values())
                        for pair in b.loop_connections()]
-        key = frozenset(connection for _, connection in connections)   # (held: no id reuse)
+        reporters = self._reporters()
+        key = (frozenset(connection for _, connection in connections), reporters)
         if key == self._watched_key:
             return
         self._watched_key = key
         self._watched_names = names = {node for node, _ in connections}
-        self.lockstep.watch.watch(self._node_processes.find(names))
+        reporting = names & reporters
+        watched = names - reporting
+        self.lockstep.wait_for(reporting, watched)
+        self.lockstep.watch.watch(self._node_processes.find(watched))
         rospy.loginfo("lockstep: waits for %s%s", ", ".join(
-            "%s (pid %s)" % (n, self._node_processes.pid_of(n)) for n in sorted(names))
+            ["%s (handshake)" % n for n in sorted(reporting)] +
+            ["%s (pid %s, watched in /proc: it sends no lockstep report)"
+             % (n, self._node_processes.pid_of(n)) for n in sorted(watched)])
             or "no controller", "; and %s (pid %s), which their service calls go through" % (
-                MASTER, self._node_processes.pid_of(MASTER)) if names else "")
+                MASTER, self._node_processes.pid_of(MASTER)) if watched else "")
+
+    def _reporters(self):
+        """The nodes whose lockstep reports reach the simulator now."""
+        impl = self._report_sub.impl if self._report_sub is not None else None
+        if impl is None:
+            return frozenset()
+        return frozenset(c.callerid_pub for c in list(impl.connections)) - {rospy.get_name()}
+
+    def _on_report(self, msg):
+        """A controller's report (lockstep_msgs/LockstepReport), named by its connection: a
+        node speaks only for itself."""
+        node = msg._connection_header.get("callerid")
+        if node is None or node == rospy.get_name():
+            return
+        self.board.take(
+            node, msg.pid, msg.seq,
+            {(t, p, port): n for t, p, port, n in zip(msg.in_topics, msg.in_peers,
+                                                       msg.in_ports, msg.in_counts)},
+            {(t, p, port): n for t, p, port, n in zip(msg.out_topics, msg.out_peers,
+                                                       msg.out_ports, msg.out_counts)},
+            served=list(zip(msg.served_services, msg.served_ports)),
+            called=list(zip(msg.called_services, msg.called_ports)))
 
     def _note_busy_loop(self, pid, tid):
         """Lockstep took thread `tid` of `pid` for a busy loop: it is not waited for."""

@@ -1,0 +1,10 @@
+"""Lockstep: the simulator runs as fast as the machine allows, and each controller still sees
+what it would see at real time (docs/lockstep.md).
+
+Controller side: tracker.py (is this process done, what has it taken in and written out),
+rospy_hooks.py (rospy fed to the tracker, the reports sent), autoload.py (loads the hooks in
+every Python process of the project's environment that imports rospy).
+Simulator side: board.py (the latest report of each controller, and whether they are all done
+with what the simulator sent them).
+"""
+REPORT_TOPIC = "/lockstep/report"

@@ -1,0 +1,146 @@
+"""The simulator's side of the handshake: the latest word of each controller, and whether
+they are all done with what the simulator sent them.
+
+A controller's process reports each time it becomes done (tracker.py), with what it has taken
+in and written out per connection, totals since the connection opened. Its report is about
+everything the simulator sent it once it counts, on every connection from the simulator, as
+many messages as the simulator wrote there; the simulator has read all it wrote once its own
+counts reach the report's. Between two controllers that both report, the same holds for their
+topics, and for a service call: a call one reports made (named by the call's connection) is
+done with once its server has reported it answered, since the server may have changed its
+mind (bug 2 switching go to point on) and its loop must look again first. A call to a server
+that does not report (the simulator's own services, a roscpp node) ended when its answer came.
+
+All counts, so a report that comes late, twice or out of order never says too much: a
+controller is done exactly when its latest report is about everything, whatever the machine's
+load. The simulator's own counts come from its own Tracker (rospy_hooks.install(report=False)).
+"""
+import collections
+import threading
+import time
+
+KEEP_CALLS = 4096          # unmatched service-call records kept (a client or server that died)
+
+
+class NodeReport:
+    def __init__(self):
+        self.pid = 0
+        self.seq = 0
+        self.reports = 0
+        self.taken = {}              # (topic, publisher, port) -> count
+        self.written = {}            # (topic, subscriber, port) -> count
+
+    def merge(self, pid, seq, taken, written):
+        """Totals only grow: a report older than one already merged changes nothing."""
+        if pid != self.pid:          # a new process under the node's name: start over
+            self.pid, self.seq, self.taken, self.written = pid, 0, {}, {}
+        self.seq = max(self.seq, seq)
+        self.reports += 1
+        for key, count in taken.items():
+            if count > self.taken.get(key, 0):
+                self.taken[key] = count
+        for key, count in written.items():
+            if count > self.written.get(key, 0):
+                self.written[key] = count
+
+
+class Board:
+    def __init__(self, own_name, own_counts, service_provider=lambda service: None):
+        """`own_name`: the simulator's node name; `own_counts()`: (taken, written) of the
+        simulator's own connections, keyed as in a report; `service_provider(name)`: the
+        node that offers a service, or None."""
+        self.own_name = own_name
+        self.own_counts = own_counts
+        self.service_provider = service_provider
+        self._reports = {}                             # node -> NodeReport
+        self._called = collections.OrderedDict()       # (service, port) -> client node
+        self._served = collections.OrderedDict()       # (service, port) -> server node
+        self._changed = threading.Condition()
+        self._version = 0            # counts changes, so that a wait misses none
+        self.silent = set()          # nodes stepped past at a time-out, until they report
+
+    # --- what comes in ----------------------------------------------------------------------
+    def take(self, node, pid, seq, taken, written, served=(), called=()):
+        """A report from `node` (its connection's callerid, never a field of the report)."""
+        with self._changed:
+            self._reports.setdefault(node, NodeReport()).merge(pid, seq, taken, written)
+            for key in served:
+                if self._called.pop(key, None) is None:
+                    self._remember(self._served, key, node)
+            for key in called:
+                if self._served.pop(key, None) is None:
+                    self._remember(self._called, key, node)
+            self.silent.discard(node)
+            self._version += 1
+            self._changed.notify_all()
+
+    @staticmethod
+    def _remember(records, key, node):
+        records[key] = node
+        while len(records) > KEEP_CALLS:
+            records.popitem(last=False)
+
+    def notify(self):
+        """The simulator's own counts changed (it read a command)."""
+        with self._changed:
+            self._version += 1
+            self._changed.notify_all()
+
+    def forget(self, node):
+        """`node` left: its report no longer counts (its connections are gone too)."""
+        with self._changed:
+            self._reports.pop(node, None)
+            self.silent.discard(node)
+
+    def report_of(self, node):
+        return self._reports.get(node)
+
+    # --- the question -----------------------------------------------------------------------
+    def busy(self, nodes):
+        """The first of `nodes` (reporting controllers) not yet done with what it was sent,
+        with why, as (node, why); None when all are done."""
+        taken_own, written_own = self.own_counts()
+        me = self.own_name
+        with self._changed:
+            reports = self._reports
+            for node in nodes:
+                if node in self.silent:
+                    continue
+                report = reports.get(node)
+                if report is None:
+                    return node, "no report yet"
+                for (topic, peer, port), count in written_own.items():
+                    if peer == node and report.taken.get((topic, me, port), 0) < count:
+                        return node, "%s not taken in: %d of %d" % (
+                            topic, report.taken.get((topic, me, port), 0), count)
+                for (topic, peer, port), count in report.written.items():
+                    if peer == me:
+                        if taken_own.get((topic, node, port), 0) < count:
+                            return node, "%s not read by the simulator yet" % topic
+                    elif peer in nodes and peer not in self.silent:
+                        other = reports.get(peer)
+                        if other is not None and \
+                                other.taken.get((topic, node, port), 0) < count:
+                            return peer, "%s from %s not taken in" % (topic, node)
+            for (service, _), client in list(self._called.items()):
+                server = self.service_provider(service)
+                if server is None or server not in reports or server in self.silent:
+                    self._called.pop((service, _), None)   # ended when its answer came
+                    continue
+                return server, "%s called by %s" % (service, client)
+        return None
+
+    def wait(self, nodes, deadline, interrupted=lambda: False):
+        """Waits until busy(nodes) is None, `deadline` (time.monotonic) passes or
+        interrupted(); returns what was still busy, or None."""
+        while True:
+            version = self._version
+            busy = self.busy(nodes)
+            if busy is None or interrupted():
+                return busy
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return busy
+            with self._changed:
+                if self._version == version:        # nothing came since the look
+                    self._changed.wait(min(left, 0.05))

@@ -1,0 +1,295 @@
+"""rospy, told to the process's Tracker (tracker.py), and the reports sent on /lockstep/report.
+
+install() wraps, in the rospy module of this process:
+  _SubscriberImpl.receive_callback   the callbacks of each message (taken in once they return)
+  TCPROSSub.read_messages            messages a subscriber's queue_size drops unread
+  TCPROSTransport.write_data         messages written to a subscriber (and to a queued
+                                     connection's socket: its queue empties)
+  QueuedConnection.write_data        messages entering a queued connection's queue
+  rospy.sleep, rospy.timer.sleep     a thread sleeping until a sim time (rospy.Rate, Timer)
+  rospy.is_shutdown                  a thread polling
+  time.sleep                         a thread waiting for the wall clock: not waited for
+  ServiceProxy.call                  a service call in flight; its answer read
+  ServiceImpl._handle_request        a service handler running
+  rospy.init_node                    opens the report publisher
+A process whose rospy is wrapped behaves as before: the wrappers count and return what rospy
+returns. Nothing is sent until the simulator subscribes to /lockstep/report, which it does
+only in lockstep.
+
+Connections are named by the TCP port of the subscriber's end (lockstep_msgs/LockstepReport).
+"""
+import os
+import threading
+import time
+import weakref
+
+from pybullet_gazebo.ros.lockstep import REPORT_TOPIC
+from pybullet_gazebo.ros.lockstep.tracker import Tracker
+
+NOT_COUNTED = {"/rosout", REPORT_TOPIC}     # topics no controller acts on
+
+TRACKER = None                              # this process's Tracker, once installed
+_publisher = None
+_reports = True                             # False in the simulator: it counts, never reports
+
+
+def install(report=True):
+    """Wraps this process's rospy (once) and returns its Tracker. `report` false: count
+    only, never report (the simulator itself)."""
+    global TRACKER, _reports
+    if not report:
+        _reports = False
+    if TRACKER is not None:
+        if not report:
+            TRACKER.reporting = lambda: False
+        return TRACKER
+    import genpy
+    import rospy
+    import rospy.core
+    import rospy.rostime
+    import rospy.timer
+    import rospy.topics
+    from rospy.impl import tcpros_base, tcpros_pubsub, tcpros_service
+
+    tracker = TRACKER = Tracker(send=_send, reporting=_reporting if report else lambda: False)
+    get_ident = threading.get_ident
+    queued = weakref.WeakSet()
+
+    def pending_writes():
+        return sum(getattr(q, "_lockstep_pending", 0) for q in list(queued)
+                   if not q._connection.done)
+    tracker.pending_writes = pending_writes
+
+    # --- taking in ----------------------------------------------------------------------
+    receive_callback = rospy.topics._SubscriberImpl.receive_callback
+
+    def counted_receive_callback(self, msgs, connection):
+        topic = self.resolved_name
+        if topic in NOT_COUNTED:
+            return receive_callback(self, msgs, connection)
+        tracker.callback_started()
+        try:
+            return receive_callback(self, msgs, connection)
+        finally:
+            now = rospy.rostime.get_rostime().to_nsec() if topic == "/clock" else None
+            tracker.callback_ended(topic, connection.callerid_pub, _local_port(connection),
+                                   len(msgs), now)
+    rospy.topics._SubscriberImpl.receive_callback = counted_receive_callback
+
+    read_messages = tcpros_pubsub.TCPROSSub.read_messages
+
+    def counted_read_messages(self, b, msg_queue, sock):
+        keep = self.queue_size
+        if not keep or keep < 0:
+            return read_messages(self, b, msg_queue, sock)
+        self.queue_size = None           # read all, then drop as rospy would, counted
+        try:
+            read_messages(self, b, msg_queue, sock)
+        finally:
+            self.queue_size = keep
+        extra = len(msg_queue) - keep
+        if extra > 0:
+            del msg_queue[:extra]
+            tracker.dropped(self.resolved_name, sock.getsockname()[1], extra)
+    tcpros_pubsub.TCPROSSub.read_messages = counted_read_messages
+
+    # --- writing out ----------------------------------------------------------------------
+    write_data = tcpros_base.TCPROSTransport.write_data
+    publishing = tcpros_pubsub.TCPROSPub
+
+    def counted_write_data(self, data):
+        outer = getattr(self, "_lockstep_queue", None)
+        try:
+            result = write_data(self, data)
+            protocol = self.protocol
+            if isinstance(protocol, publishing) and protocol.resolved_name not in NOT_COUNTED:
+                tracker.wrote(protocol.resolved_name, self.endpoint_id, _peer_port(self))
+            return result
+        finally:
+            if outer is not None:
+                outer._lockstep_pending -= 1
+                tracker.unqueued()
+    tcpros_base.TCPROSTransport.write_data = counted_write_data
+
+    queued_init = tcpros_pubsub.QueuedConnection.__init__
+    queued_write = tcpros_pubsub.QueuedConnection.write_data
+
+    def tracked_queued_init(self, connection, queue_size):
+        queued_init(self, connection, queue_size)
+        self._lockstep_pending = 0
+        connection._lockstep_queue = self
+        queued.add(self)
+
+    def counted_queued_write(self, data):
+        with self._lock:
+            if not (self._queue_size > 0 and len(self._queue) == self._queue_size):
+                self._lockstep_pending += 1     # (a full queue drops its oldest: no change)
+        return queued_write(self, data)
+    tcpros_pubsub.QueuedConnection.__init__ = tracked_queued_init
+    tcpros_pubsub.QueuedConnection.write_data = counted_queued_write
+
+    publish = rospy.topics.Publisher.publish
+
+    def noted_publish(self, *args, **kwds):
+        tracker.published(get_ident())
+        return publish(self, *args, **kwds)
+    rospy.topics.Publisher.publish = noted_publish
+
+    # --- sleeping and polling -------------------------------------------------------------
+    sleep = rospy.timer.sleep
+
+    def tracked_sleep(duration):
+        if rospy.rostime.is_wallclock():
+            return sleep(duration)
+        if not isinstance(duration, genpy.Duration):
+            duration = genpy.Duration.from_sec(duration)
+        length = duration.to_nsec()
+        if length <= 0:
+            return sleep(duration)
+        tid = get_ident()
+        tracker.sleep_started(tid, rospy.rostime.get_rostime().to_nsec(), length)
+        try:
+            return sleep(duration)
+        finally:
+            tracker.sleep_ended(tid)
+    rospy.timer.sleep = rospy.sleep = tracked_sleep
+
+    wall_sleep = time.sleep
+
+    def noted_wall_sleep(seconds):
+        tracker.wall_sleep(get_ident())
+        return wall_sleep(seconds)
+    time.sleep = noted_wall_sleep
+
+    is_shutdown = rospy.core.is_shutdown
+
+    def polled_is_shutdown():
+        tracker.polled(get_ident())
+        return is_shutdown()
+    rospy.is_shutdown = polled_is_shutdown
+
+    # --- services -------------------------------------------------------------------------
+    call = tcpros_service.ServiceProxy.call
+
+    def tracked_call(self, *args, **kwds):
+        tid = get_ident()
+        tracker.call_started(tid)
+        try:
+            return call(self, *args, **kwds)
+        finally:
+            tracker.call_ended(tid)
+    tcpros_service.ServiceProxy.call = tracked_call
+
+    read_answer = tcpros_service.TCPROSServiceClient.read_messages
+
+    def noted_read_answer(self, b, msg_queue, sock):
+        read_answer(self, b, msg_queue, sock)
+        if msg_queue:
+            tracker.call_answered(self.resolved_name, sock.getsockname()[1])
+    tcpros_service.TCPROSServiceClient.read_messages = noted_read_answer
+
+    handle_request = tcpros_service.ServiceImpl._handle_request
+
+    def tracked_handle_request(self, transport, request):
+        tracker.handler_started()
+        port = 0
+        try:
+            port = _peer_port(transport)
+            return handle_request(self, transport, request)
+        finally:
+            tracker.handler_ended(self.resolved_name, port)
+    tcpros_service.ServiceImpl._handle_request = tracked_handle_request
+
+    # --- the report publisher -----------------------------------------------------------
+    init_node = rospy.client.init_node
+
+    def reporting_init_node(*args, **kwds):
+        result = init_node(*args, **kwds)
+        if _reports:
+            try:
+                _open_publisher()
+            except ImportError:         # lockstep_msgs not built: the process is not heard
+                pass
+        return result
+    rospy.init_node = rospy.client.init_node = reporting_init_node
+    return tracker
+
+
+def _local_port(connection):
+    port = getattr(connection, "_lockstep_port", None)
+    if port is None:
+        try:
+            port = connection.socket.getsockname()[1]
+        except (AttributeError, OSError):
+            port = 0
+        connection._lockstep_port = port
+    return port
+
+
+def _peer_port(connection):
+    port = getattr(connection, "_lockstep_port", None)
+    if port is None:
+        try:
+            port = connection.socket.getpeername()[1]
+        except (AttributeError, OSError):
+            port = 0
+        connection._lockstep_port = port
+    return port
+
+
+def _open_publisher():
+    """The report publisher: latched, written in the reporting thread (no queue: a report
+    must leave before the thread goes on). A simulator that connects gets the counts as they
+    are at once."""
+    global _publisher
+    import warnings
+
+    import rospy
+    from lockstep_msgs.msg import LockstepReport
+
+    class _OnConnect(rospy.SubscribeListener):
+        def peer_subscribe(self, topic_name, topic_publish, peer_publish):
+            report = TRACKER.report_now()
+            if report is not None:
+                peer_publish(_message(report))
+
+    with warnings.catch_warnings():          # rospy warns when queue_size is None: on purpose
+        warnings.simplefilter("ignore", SyntaxWarning)
+        _publisher = rospy.Publisher(REPORT_TOPIC, LockstepReport, queue_size=None,
+                                     latch=True, subscriber_listener=_OnConnect())
+
+
+def _reporting():
+    publisher = _publisher
+    return publisher is not None and publisher.get_num_connections() > 0
+
+
+def _message(report):
+    from lockstep_msgs.msg import LockstepReport
+    msg = LockstepReport(pid=os.getpid(), seq=report["seq"])
+    for key, count in report["taken"].items():
+        msg.in_topics.append(key[0])
+        msg.in_peers.append(key[1])
+        msg.in_ports.append(key[2])
+        msg.in_counts.append(count)
+    for key, count in report["written"].items():
+        msg.out_topics.append(key[0])
+        msg.out_peers.append(key[1])
+        msg.out_ports.append(key[2])
+        msg.out_counts.append(count)
+    for service, port in report["served"]:
+        msg.served_services.append(service)
+        msg.served_ports.append(port)
+    for service, port in report["called"]:
+        msg.called_services.append(service)
+        msg.called_ports.append(port)
+    return msg
+
+
+def _send(report):
+    publisher = _publisher
+    if publisher is not None:
+        try:
+            publisher.publish(_message(report))
+        except Exception:       # noqa: BLE001 (shutting down: the simulator no longer waits)
+            pass

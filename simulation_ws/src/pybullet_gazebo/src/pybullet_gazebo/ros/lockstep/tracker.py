@@ -1,0 +1,230 @@
+"""What one process has taken in, written out, and whether it is done: the controller's side
+of lockstep's handshake, kept free of rospy so that it can be tested on its own (the rospy
+hooks that feed it are in rospy_hooks.py).
+
+A process is done when
+  - no callback of a subscriber, and no service handler, is running;
+  - no service call of its own is in flight;
+  - no thread is due: a thread that slept in rospy.sleep (a rospy.Rate or rospy.Timer loop)
+    is due from the /clock tick that reaches its wake-up time until it sleeps again, or
+    until it polls; a thread that polls (calls rospy.is_shutdown() twice with nothing in
+    between: no publish, no sleep, no service call) is a busy loop waiting for something to
+    change, and it is done; when a callback or a handler ends it is due again until it has
+    polled once more, since what it polls for may have changed;
+  - nothing it published waits in a queued connection's queue.
+Each time it becomes done with something new to say, it sends a report (`send`): the
+messages taken in and written out per connection, and the service calls answered and made
+since the last report. The simulator compares those counts with its own (board.py), so it
+knows the report is about everything it sent, and that it has read everything the process
+wrote.
+
+While reporting is on (the simulator listens: `reporting()`), a polling thread is held in its
+rospy.is_shutdown() until something happens in the process, instead of spinning: it would
+take the GIL from the callbacks for Python's switch interval (5 ms) at every message, and a
+core from the simulator. What it polls for can only change when something happens; `POLL_CAP`
+bounds the hold for anything the tracker cannot see (a thread timed by the wall clock).
+"""
+import threading
+
+POLL_CAP = 0.05          # [s] wall: the longest a polling thread is held at a time
+
+_POLL, _OTHER = "poll", "other"
+
+
+class Tracker:
+    def __init__(self, send=lambda report: None, reporting=lambda: False):
+        self.send = send                  # send(report dict): to the simulator
+        self.reporting = reporting        # () -> True while the simulator listens
+        self._lock = threading.Lock()
+        self._changed = threading.Condition(self._lock)   # pollers wait on it
+        self._running = 0                 # callbacks and handlers running
+        self._calls = 0                   # service calls in flight
+        self._due = set()                 # thread ids due (see the module docstring)
+        self._sleeping = {}               # thread id -> (start, wake, duration) [ns sim]
+        self._last = {}                   # thread id -> _POLL or _OTHER: its last event
+        self._held = set()                # polling threads held now
+        self.pending_writes = lambda: 0   # messages waiting in queued connections
+        self.taken = {}                   # (topic, peer, port) -> messages taken in
+        self._dropped = {}                # (topic, port) -> dropped by queue_size
+        self.written = {}                 # (topic, peer, port) -> messages written
+        self._served = []                 # [(service, port)] answered since the last report
+        self._called = []                 # [(service, port)] made since the last report
+        self._news = False                # something to report once done
+        self.seq = 0
+        self.on_change = None             # called (no lock held) when counts change
+
+    # --- what the hooks say ------------------------------------------------------------
+    def callback_started(self):
+        with self._lock:
+            self._running += 1
+
+    def callback_ended(self, topic, peer, port, count, now=None):
+        """`count` messages of (topic, peer, port) went through every callback; `now` [ns sim]:
+        the time a /clock message just set (wakes the sleepers it reaches)."""
+        with self._lock:
+            key = (topic, peer, port)
+            self.taken[key] = self.taken.get(key, 0) + count
+            if now is not None:
+                self._wake_sleepers(now)
+            self._running -= 1
+            self._wake_pollers()
+        self._after_change()
+
+    def dropped(self, topic, port, count):
+        """A subscriber's queue_size dropped `count` messages unread: they are done with."""
+        with self._lock:
+            key = (topic, port)
+            self._dropped[key] = self._dropped.get(key, 0) + count
+
+    def handler_started(self):
+        with self._lock:
+            self._running += 1
+
+    def handler_ended(self, service, port):
+        with self._lock:
+            if self.reporting():
+                self._served.append((service, port))
+            self._running -= 1
+            self._wake_pollers()
+        self._after_change()
+
+    def call_started(self, tid):
+        with self._lock:
+            self._calls += 1
+            self._last[tid] = _OTHER
+
+    def call_answered(self, service, port):
+        with self._lock:
+            if self.reporting():
+                self._called.append((service, port))
+
+    def call_ended(self, tid):
+        with self._lock:
+            self._calls -= 1
+            self._wake_pollers()
+        self._after_change()
+
+    def wrote(self, topic, peer, port):
+        with self._lock:
+            key = (topic, peer, port)
+            self.written[key] = self.written.get(key, 0) + 1
+            self._news = True
+        if self.on_change is not None:
+            self.on_change()
+
+    def unqueued(self):
+        """A queued connection wrote a message (pending_writes() fell)."""
+        self._after_change()
+
+    def published(self, tid):
+        with self._lock:
+            self._last[tid] = _OTHER
+
+    def sleep_started(self, tid, start, duration):
+        """Thread `tid` sleeps `duration` from sim time `start` [ns sim]; start 0: sim time
+        is not set yet, and rospy's sleep starts counting at the first /clock."""
+        with self._lock:
+            self._sleeping[tid] = (start, start + duration if start else None, duration)
+            self._due.discard(tid)
+            self._last[tid] = _OTHER
+        self._after_change()
+
+    def wall_sleep(self, tid):
+        """Thread `tid` waits for the wall clock: it is timed by the machine, not by sim
+        time, and nothing it does next can be waited for."""
+        if tid in self._due:
+            with self._lock:
+                self._due.discard(tid)
+                self._last[tid] = _OTHER
+            self._after_change()
+
+    def sleep_ended(self, tid):
+        with self._lock:
+            self._sleeping.pop(tid, None)
+
+    def time_set(self, now):
+        """Sim time is `now` [ns] (for a /clock message read outside a callback)."""
+        with self._lock:
+            self._wake_sleepers(now)
+
+    def polled(self, tid):
+        """Thread `tid` called rospy.is_shutdown(); a second call with nothing between makes
+        it a poller: done, and held (while reporting) until something happens."""
+        with self._lock:
+            if self._last.get(tid) != _POLL:
+                self._last[tid] = _POLL
+                return
+            self._due.discard(tid)
+        self._after_change()
+        if not self.reporting():
+            return
+        with self._lock:
+            self._held.add(tid)
+            try:
+                self._changed.wait(POLL_CAP)
+            finally:
+                self._held.discard(tid)
+
+    def forget_thread(self, tid):
+        with self._lock:
+            self._due.discard(tid)
+            self._sleeping.pop(tid, None)
+            self._last.pop(tid, None)
+        self._after_change()
+
+    # --- state ---------------------------------------------------------------------------
+    def counts(self):
+        """(taken, written): copies, for the simulator's board."""
+        with self._lock:
+            return dict(self.taken), dict(self.written)
+
+    def done(self):
+        with self._lock:
+            return self._done()
+
+    def _done(self):
+        return not (self._running or self._calls or self._due or self.pending_writes())
+
+    def _wake_sleepers(self, now):
+        for tid, (start, wake, duration) in list(self._sleeping.items()):
+            if wake is None:
+                if now:
+                    self._sleeping[tid] = (now, now + duration, duration)
+            elif now >= wake or now < start:
+                self._due.add(tid)
+
+    def _wake_pollers(self):
+        """Something happened: a held poller must look again before the process is done."""
+        self._news = True
+        if self._held:
+            self._due.update(self._held)        # (its next poll, if it finds nothing to do,
+            self._changed.notify_all()          # is a second one in a row: done again)
+
+    def _after_change(self):
+        report = None
+        with self._lock:
+            if self._news and self._done() and self.reporting():
+                report = self._report()
+        if report is not None:
+            self.send(report)
+        if self.on_change is not None:
+            self.on_change()
+
+    def _report(self):
+        self._news = False
+        self.seq += 1
+        taken = dict(self.taken)
+        for (topic, peer, port) in list(taken):
+            taken[(topic, peer, port)] += self._dropped.get((topic, port), 0)
+        served, self._served = self._served, []
+        called, self._called = self._called, []
+        return {"seq": self.seq, "taken": taken, "written": dict(self.written),
+                "served": served, "called": called}
+
+    def report_now(self):
+        """A report of the counts as they are (for a simulator that just connected)."""
+        with self._lock:
+            if not self._done():
+                self._news = True
+                return None
+            return self._report()

@@ -1,0 +1,118 @@
+"""The simulator's side of lockstep's handshake without ROS: whether the controllers' reports
+say they are done with everything the simulator sent them (pybullet_gazebo/ros/lockstep/
+board.py)."""
+import threading
+import time
+
+from pybullet_gazebo.ros.lockstep.board import Board
+
+SIM = "/gazebo"
+
+
+class Own:
+    """The simulator's own counts (its Tracker's)."""
+
+    def __init__(self):
+        self.taken, self.written = {}, {}
+
+    def __call__(self):
+        return dict(self.taken), dict(self.written)
+
+
+def make(providers=None):
+    own = Own()
+    board = Board(SIM, own, service_provider=(providers or {}).get)
+    return board, own
+
+
+def test_busy_until_the_report_counts_every_message_sent():
+    board, own = make()
+    own.written[("/scan", "/ctl", 5)] = 3
+    assert board.busy({"/ctl"}) == ("/ctl", "no report yet")
+    board.take("/ctl", pid=1, seq=1, taken={("/scan", SIM, 5): 2}, written={})
+    assert board.busy({"/ctl"})[0] == "/ctl"
+    board.take("/ctl", pid=1, seq=2, taken={("/scan", SIM, 5): 3}, written={})
+    assert board.busy({"/ctl"}) is None
+
+
+def test_busy_until_the_simulator_has_read_every_command_reported():
+    board, own = make()
+    board.take("/ctl", 1, 1, taken={}, written={("/cmd_vel", SIM, 6): 4})
+    own.taken[("/cmd_vel", "/ctl", 6)] = 3
+    assert "not read by the simulator" in board.busy({"/ctl"})[1]
+    own.taken[("/cmd_vel", "/ctl", 6)] = 4
+    assert board.busy({"/ctl"}) is None
+
+
+def test_a_late_or_repeated_report_says_nothing_false():
+    board, own = make()
+    own.written[("/scan", "/ctl", 5)] = 3
+    board.take("/ctl", 1, 9, taken={("/scan", SIM, 5): 3}, written={})
+    board.take("/ctl", 1, 4, taken={("/scan", SIM, 5): 1}, written={})     # an old one
+    board.take("/ctl", 1, 9, taken={("/scan", SIM, 5): 3}, written={})     # twice
+    assert board.busy({"/ctl"}) is None
+
+
+def test_a_restarted_node_starts_over():
+    board, own = make()
+    board.take("/ctl", 1, 50, taken={("/scan", SIM, 5): 50}, written={})
+    own.written[("/scan", "/ctl", 7)] = 1                  # the new process's connection
+    board.take("/ctl", 2, 1, taken={("/scan", SIM, 7): 1}, written={})
+    assert board.report_of("/ctl").taken == {("/scan", SIM, 7): 1}
+    assert board.busy({"/ctl"}) is None
+
+
+def test_a_topic_between_two_controllers_must_be_taken_in():
+    board, _ = make()
+    board.take("/a", 1, 1, taken={}, written={("/plan", "/b", 8): 2})
+    board.take("/b", 2, 1, taken={("/plan", "/a", 8): 1}, written={})
+    assert board.busy({"/a", "/b"}) == ("/b", "/plan from /a not taken in")
+    board.take("/b", 2, 2, taken={("/plan", "/a", 8): 2}, written={})
+    assert board.busy({"/a", "/b"}) is None
+
+
+def test_a_service_call_waits_for_its_server_in_either_order():
+    providers = {"/go_to_point_switch": "/go_to_point"}
+    board, _ = make(providers)
+    nodes = {"/bug2", "/go_to_point"}
+    board.take("/go_to_point", 1, 1, taken={}, written={})
+    board.take("/bug2", 2, 1, taken={}, written={}, called=[("/go_to_point_switch", 9)])
+    assert board.busy(nodes) == ("/go_to_point", "/go_to_point_switch called by /bug2")
+    board.take("/go_to_point", 1, 2, taken={}, written={},
+               served=[("/go_to_point_switch", 9)])
+    assert board.busy(nodes) is None
+    # the server's report first, the client's after: matched all the same
+    board.take("/go_to_point", 1, 3, taken={}, written={},
+               served=[("/go_to_point_switch", 10)])
+    board.take("/bug2", 2, 2, taken={}, written={}, called=[("/go_to_point_switch", 10)])
+    assert board.busy(nodes) is None
+
+
+def test_a_call_to_a_server_that_does_not_report_ended_with_its_answer():
+    board, _ = make({"/gazebo/get_model_state": SIM})
+    board.take("/ctl", 1, 1, taken={}, written={}, called=[("/gazebo/get_model_state", 9),
+                                                          ("/nobody", 10)])
+    assert board.busy({"/ctl"}) is None
+
+
+def test_a_node_stepped_past_is_skipped_until_it_reports_again():
+    board, own = make()
+    own.written[("/scan", "/ctl", 5)] = 1
+    board.take("/ctl", 1, 1, taken={}, written={})
+    board.silent.add("/ctl")
+    assert board.busy({"/ctl"}) is None
+    board.take("/ctl", 1, 2, taken={}, written={})
+    assert board.busy({"/ctl"}) is not None
+
+
+def test_wait_returns_as_soon_as_the_report_comes():
+    board, own = make()
+    own.written[("/scan", "/ctl", 5)] = 1
+    threading.Timer(0.05, board.take, args=("/ctl", 1, 1),
+                    kwargs=dict(taken={("/scan", SIM, 5): 1}, written={})).start()
+    start = time.monotonic()
+    assert board.wait({"/ctl"}, start + 5.0) is None
+    assert time.monotonic() - start < 0.5
+    own.written[("/scan", "/ctl", 5)] = 2
+    assert board.wait({"/ctl"}, time.monotonic() + 0.1) == \
+        ("/ctl", "/scan not taken in: 1 of 2")

@@ -1,0 +1,159 @@
+"""The controller's side of lockstep's handshake without ROS: when a process is done, and
+what its reports say (pybullet_gazebo/ros/lockstep/tracker.py)."""
+import threading
+import time
+
+from pybullet_gazebo.ros.lockstep.tracker import Tracker
+
+SCAN = ("/m2wr/laser/scan", "/gazebo", 50001)
+CLOCK = ("/clock", "/gazebo", 50002)
+MS = 1000000                                   # [ns] a millisecond of sim time
+
+
+def make(reporting=True):
+    reports = []
+    tracker = Tracker(send=reports.append, reporting=lambda: reporting)
+    return tracker, reports
+
+
+def test_a_callback_is_reported_once_it_returns_with_its_counts():
+    tracker, reports = make()
+    tracker.callback_started()
+    assert not tracker.done() and reports == []
+    tracker.wrote("/cmd_vel", "/gazebo", 40000)        # the callback's command
+    tracker.callback_ended(*SCAN, count=1)
+    assert tracker.done()
+    assert len(reports) == 1
+    assert reports[0]["taken"] == {SCAN: 1}
+    assert reports[0]["written"] == {("/cmd_vel", "/gazebo", 40000): 1}
+
+
+def test_a_loop_thread_is_due_from_its_tick_until_it_sleeps_again():
+    tracker, reports = make()
+    tracker.sleep_started(tid=7, start=1000 * MS, duration=50 * MS)     # rate.sleep() at 1 s
+    tracker.callback_started()
+    tracker.callback_ended(*CLOCK, count=1, now=1020 * MS)             # not yet its time
+    assert tracker.done() and len(reports) == 1
+    tracker.callback_started()
+    tracker.callback_ended(*CLOCK, count=1, now=1050 * MS)             # its tick
+    assert not tracker.done() and len(reports) == 1                    # the loop acts first
+    tracker.sleep_ended(7)
+    tracker.published(7)
+    tracker.wrote("/cmd_vel", "/gazebo", 40000)
+    tracker.sleep_started(tid=7, start=1050 * MS, duration=50 * MS)     # back to sleep
+    assert tracker.done() and len(reports) == 2
+    assert reports[1]["taken"] == {CLOCK: 2}
+    assert reports[1]["written"] == {("/cmd_vel", "/gazebo", 40000): 1}
+
+
+def test_a_sleep_begun_before_the_first_clock_counts_from_it():
+    tracker, _ = make()
+    tracker.sleep_started(tid=7, start=0, duration=50 * MS)      # sim time not set yet
+    tracker.time_set(5000 * MS)                                 # first /clock: 5 s
+    assert tracker.done()
+    tracker.time_set(5049 * MS)
+    assert tracker.done()
+    tracker.time_set(5050 * MS)
+    assert not tracker.done()
+
+
+def test_time_moving_backwards_wakes_a_sleeper():
+    tracker, _ = make()
+    tracker.sleep_started(tid=7, start=9000 * MS, duration=50 * MS)
+    tracker.time_set(0)                                         # reset_simulation
+    assert not tracker.done()
+
+
+def test_a_thread_that_only_polls_is_done_and_held_until_something_happens():
+    tracker, reports = make()
+    tracker.sleep_started(tid=7, start=MS, duration=MS)
+    tracker.callback_started()
+    tracker.callback_ended(*CLOCK, count=1, now=2 * MS)
+    tracker.sleep_ended(7)
+    assert not tracker.done()                   # woken: due
+    tracker.polled(7)                           # the loop's head: still due
+    assert not tracker.done()
+    released = []
+
+    def second_poll():
+        tracker.polled(7)                       # round again without doing anything
+        released.append(time.monotonic())
+    poller = threading.Thread(target=second_poll)
+    poller.start()
+    deadline = time.monotonic() + 2
+    while not tracker.done() and time.monotonic() < deadline:
+        time.sleep(0.001)
+    assert tracker.done() and reports               # a poller is done: reported
+    time.sleep(0.01)
+    assert not released                              # and held, not spinning
+    tracker.callback_started()
+    tracker.callback_ended(*SCAN, count=1)            # something happened
+    assert not tracker.done()                         # it must look again first
+    poller.join(2)
+    assert released
+    tracker.polled(7)                                 # it looked: nothing for it
+    assert tracker.done()
+
+
+def test_a_poller_is_not_held_at_real_time():
+    tracker, _ = make(reporting=False)
+    tracker.polled(7)
+    start = time.monotonic()
+    for _ in range(1000):
+        tracker.polled(7)
+    assert time.monotonic() - start < 0.04           # 1000 polls, none held for POLL_CAP
+
+
+def test_a_service_call_in_flight_keeps_the_process_busy():
+    tracker, reports = make()
+    tracker.call_started(tid=7)
+    assert not tracker.done()
+    tracker.call_answered("/go_to_point_switch", 41000)
+    tracker.call_ended(tid=7)
+    assert tracker.done()
+    assert reports[-1]["called"] == [("/go_to_point_switch", 41000)]
+    tracker.handler_started()
+    tracker.handler_ended("/wall_follower_switch", 42000)
+    assert reports[-1]["served"] == [("/wall_follower_switch", 42000)]
+    assert reports[-1]["called"] == []                  # each call reported once
+
+
+def test_a_message_waiting_in_a_queue_keeps_the_process_busy():
+    tracker, reports = make()
+    queued = [1]
+    tracker.pending_writes = lambda: queued[0]
+    tracker.callback_started()
+    tracker.callback_ended(*SCAN, count=1)
+    assert not tracker.done() and reports == []
+    queued[0] = 0
+    tracker.wrote("/cmd_vel", "/gazebo", 40000)
+    tracker.unqueued()
+    assert tracker.done() and reports[-1]["written"] == {("/cmd_vel", "/gazebo", 40000): 1}
+
+
+def test_a_due_thread_that_waits_for_the_wall_clock_is_not_waited_for():
+    tracker, _ = make()
+    tracker.sleep_started(tid=7, start=MS, duration=MS)
+    tracker.time_set(2 * MS)
+    assert not tracker.done()
+    tracker.wall_sleep(7)                       # time.sleep: timed by the machine
+    assert tracker.done()
+
+
+def test_dropped_messages_count_as_taken_in():
+    tracker, reports = make()
+    tracker.dropped(SCAN[0], SCAN[2], 2)        # queue_size=1 kept the newest of three
+    tracker.callback_started()
+    tracker.callback_ended(*SCAN, count=1)
+    assert reports[-1]["taken"] == {SCAN: 3}
+
+
+def test_nothing_is_sent_while_the_simulator_does_not_listen():
+    tracker, reports = make(reporting=False)
+    tracker.callback_started()
+    tracker.callback_ended(*SCAN, count=1)
+    tracker.call_started(1)
+    tracker.call_answered("/s", 1)
+    tracker.call_ended(1)
+    assert reports == [] and tracker.done()
+    assert tracker.report_now()["called"] == []     # nothing kept for no one
