@@ -119,6 +119,8 @@ def wait_counting(session, timeout=10.0):
 
 # obstacle_avoidance.py's rules on a rospy.Rate(20) loop of their own (loop_avoidance.py)
 LOOP_PROGRAM = (sys.executable, "-m", "m2wr_tools.loop_avoidance")
+# obstacle_avoidance.py beside a behaviour spinning while switched off (switched_off_beside.py)
+BUSY_PROGRAM = (sys.executable, "-m", "m2wr_tools.switched_off_beside")
 
 
 def start_loop(session, lockstep, clock_hz, extra=(), controller=None):
@@ -164,7 +166,7 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
     say("%s: simulator real_time_factor 0, lockstep %s, /clock %g Hz%s%s%s" % (
         name, str(lockstep).lower(), clock_hz, ", with listeners" if watchers else "",
         "".join(", " + arg for arg in extra),
-        ", the loop program (loop_avoidance.py)" if controller else ""))
+        ", %s" % " ".join(controller[2:]) if controller else ""))
     sim_pid, ctrl_pid = start_loop(session, lockstep, clock_hz, extra, controller)
     try:
         if watchers:

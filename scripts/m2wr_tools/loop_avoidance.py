@@ -5,7 +5,9 @@ case. Same node name (reading_laser), topics, rules and log lines as the tutoria
 only what makes it act differs. The benchmark measures lockstep with it beside the tutorial's
 own program (a loop program against a scan-answering one).
 
-    python -m m2wr_tools.loop_avoidance [_rate:=20]
+    python -m m2wr_tools.loop_avoidance [_rate:=20] [_timer:=true]
+
+With `_timer:=true` a rospy.Timer at the same rate acts instead of the loop.
 """
 import rospy
 from geometry_msgs.msg import Twist
@@ -17,11 +19,17 @@ from . import tutorial_scripts
 def main():
     tutorial = tutorial_scripts.load("obstacle_avoidance.py")
     rospy.init_node("reading_laser")
-    rate = rospy.Rate(rospy.get_param("~rate", 20.0))
+    hz = rospy.get_param("~rate", 20.0)
     tutorial.pub = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
     latest = []
     rospy.Subscriber("/m2wr/laser/scan", LaserScan, lambda msg: latest[:1].clear()
                      or latest.append(msg))
+    if rospy.get_param("~timer", False):
+        rospy.Timer(rospy.Duration(1.0 / hz),
+                    lambda _event: latest and tutorial.clbk_laser(latest[-1]))
+        rospy.spin()
+        return
+    rate = rospy.Rate(hz)
     try:
         while not rospy.is_shutdown():
             if latest:

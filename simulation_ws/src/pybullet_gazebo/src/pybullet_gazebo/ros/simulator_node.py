@@ -28,6 +28,7 @@ pacing (real_time_factor, lockstep: pacing.py) lives in the adapter, never in th
 """
 import threading
 import time
+from collections import Counter
 
 import pybullet
 import rospy
@@ -39,7 +40,7 @@ from pybullet_gazebo.engine.client import Client
 from pybullet_gazebo.engine.world import World
 from pybullet_gazebo.gui.window import open_window
 from pybullet_gazebo.ros import conversions
-from pybullet_gazebo.ros.bindings import BindingContext, RobotBindings
+from pybullet_gazebo.ros.bindings import BindingContext, DriveBinding, RobotBindings
 from pybullet_gazebo.ros.clock_topic import ClockTopic
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
@@ -227,6 +228,25 @@ class SimulatorNode:
         if commands:
             rospy.loginfo("run summary: commands received: %s", ", ".join(
                 "%d from %s" % (n, node) for node, n in commands.most_common()))
+        dropped = self._dropped_commands()
+        if dropped:
+            rospy.loginfo("run summary: commands dropped unread (a newer one came with them: a "
+                          "drive keeps the newest, queue_size 1, as Gazebo's): %s", ", ".join(
+                              "%d from %s" % (n, node) for node, n in dropped.most_common()))
+
+    def _dropped_commands(self):
+        """Commands the drives' subscribers dropped unread, by node (lockstep counts them)."""
+        tracker = rospy_hooks.TRACKER
+        if tracker is None:
+            return Counter()
+        topics = {b.topic(b.names.command_topic) for bindings in self._bindings.values()
+                  for b in bindings.by_part.values() if isinstance(b, DriveBinding)}
+        taken, _ = tracker.counts()
+        dropped = Counter()
+        for (topic, node, port), count in taken.items():
+            if topic in topics:
+                dropped[node] += count - tracker.taken.get((topic, node, port), 0)
+        return +dropped
 
     def _loop(self):
         lockstep = self.lockstep.enabled

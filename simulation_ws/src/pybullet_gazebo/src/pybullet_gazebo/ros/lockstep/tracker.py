@@ -176,7 +176,15 @@ class Tracker:
     def counts(self):
         """(taken, written): copies, for the simulator's board."""
         with self._lock:
-            return dict(self.taken), dict(self.written)
+            return self._taken(), dict(self.written)
+
+    def _taken(self):
+        """Taken in per connection, the messages its queue dropped unread included."""
+        taken = dict(self.taken)
+        if self._dropped:
+            for (topic, peer, port) in list(taken):
+                taken[(topic, peer, port)] += self._dropped.get((topic, port), 0)
+        return taken
 
     def done(self):
         with self._lock:
@@ -213,9 +221,7 @@ class Tracker:
     def _report(self):
         self._news = False
         self.seq += 1
-        taken = dict(self.taken)
-        for (topic, peer, port) in list(taken):
-            taken[(topic, peer, port)] += self._dropped.get((topic, port), 0)
+        taken = self._taken()
         served, self._served = self._served, []
         called, self._called = self._called, []
         return {"seq": self.seq, "taken": taken, "written": dict(self.written),

@@ -1,0 +1,60 @@
+"""Lockstep by handshake (issue 36): the controllers' processes say when they are done, so a
+run is the same to the bit whatever else the machine does, for a program that answers scans
+and for rospy.Rate and rospy.Timer loops; a controller the simulator cannot see as a local
+process (another PID namespace, as on another machine) is waited for exactly all the same;
+one that cannot report (LOCKSTEP_HANDSHAKE=off) is watched in /proc, and the run summary says
+which way each was waited for. Each run is scripts/test/fixtures/neighbours_run.py: its own
+master, everything stopped by PID at its end."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from m2wr_tools.paths import ROOT
+
+RUN = os.path.join(ROOT, "scripts", "test", "fixtures", "neighbours_run.py")
+SECONDS = 8.0                # [s] sim
+
+
+def run(log_dir, *options):
+    done = subprocess.run([sys.executable, RUN, str(log_dir), "--seconds", str(SECONDS)]
+                          + list(options), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, timeout=300, stdin=subprocess.DEVNULL)
+    assert done.returncode == 0, done.stdout
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def lockstep_line(result):
+    line, = [line for line in result["summary"] if "lockstep:" in line]
+    return line
+
+
+@pytest.mark.parametrize("controller", ["tutorial", "loop10", "loop50", "timer20"])
+def test_the_same_run_to_the_bit_with_both_cores_busy(tmp_path, controller):
+    idle = run(tmp_path / "idle", "--controller", controller)
+    loaded = run(tmp_path / "loaded", "--controller", controller, "--busy-cores", "2")
+    assert idle["m2wr"][0] > 1.0                        # m2wr drove east from x 0
+    assert idle["track_sha256"] == loaded["track_sha256"], (idle["m2wr"], loaded["m2wr"])
+    for result in (idle, loaded):
+        line = lockstep_line(result)
+        assert "0 time-outs" in line, line
+        assert "by handshake (exact): " in line and "/reading_laser" in line, line
+        assert "watched in /proc" not in line, line
+
+
+def test_a_controller_in_another_pid_namespace_is_waited_for_exactly(tmp_path):
+    here = run(tmp_path / "here")
+    isolated = run(tmp_path / "isolated", "--isolated")
+    assert here["track_sha256"] == isolated["track_sha256"]
+    line = lockstep_line(isolated)
+    assert "by handshake (exact): " in line and "/reading_laser" in line and \
+        "0 time-outs" in line, line
+
+
+def test_an_uninstrumented_controller_falls_back_to_the_proc_watch_named(tmp_path):
+    result = run(tmp_path / "watched", "--no-handshake")
+    assert result["m2wr"][0] > 1.0
+    line = lockstep_line(result)
+    assert "watched in /proc (no handshake): /reading_laser" in line, line
