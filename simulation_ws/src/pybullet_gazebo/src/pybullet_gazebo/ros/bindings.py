@@ -124,8 +124,11 @@ class DriveBinding(Binding):
                        self.frame(self.names.robot_base_frame, fall_back_to_namespace=True))
         # /tf is advertised once a robot needs it (an empty world offers no /tf, as Gazebo)
         self.tf = context.tf_publisher() if part.publish_odom_tf else None
+        # tcp_nodelay: a transport hint only (the command comes at once, not after the
+        # publisher's kernel has waited for the ACK of the last one)
         self.subscribers.append(rospy.Subscriber(self.topic(self.names.command_topic), Twist,
-                                                 self._on_command, queue_size=1))
+                                                 self._on_command, queue_size=1,
+                                                 tcp_nodelay=True))
 
     def _on_command(self, msg):
         self.context.commands_by_node[msg._connection_header.get("callerid", "?")] += 1

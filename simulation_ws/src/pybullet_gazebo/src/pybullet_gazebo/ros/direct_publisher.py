@@ -19,8 +19,14 @@ misses one.
 `publish(msg, share)`: `share(connection)` picks the subscribers that get this message
 (clock_topic.py sends every /clock tick to controllers, fewer to displays). Whatever the
 subset, the message is serialized once and the same bytes written to each socket.
+
+Every subscriber's socket gets TCP_NODELAY, whatever the subscriber asked for: with Nagle's
+algorithm a message written while the last one is not yet acknowledged waits in the kernel
+for that ACK, which a receiver that sends nothing back delays; in lockstep the simulator then
+waits for a message its controller has not got.
 """
 import select
+import socket
 import warnings
 
 import rospy
@@ -33,6 +39,7 @@ class DirectPublisher:
             warnings.simplefilter("ignore", SyntaxWarning)
             self.publisher = rospy.Publisher(topic, data_class, queue_size=None, latch=latch)
         self.skipped = 0                    # messages not sent to a subscriber that lagged
+        self._no_delay = set()              # ids of the connections given TCP_NODELAY
 
     def get_num_connections(self):
         return self.publisher.get_num_connections()
@@ -53,6 +60,8 @@ class DirectPublisher:
         if not connections:
             impl.publish(msg)             # keeps rospy's latch and sequence number
             return
+        if len(self._no_delay) != len(connections):
+            self._set_no_delay(connections)
         everyone = len(connections)
         if share is not None:
             connections = [c for c in connections if share(c)]
@@ -68,6 +77,17 @@ class DirectPublisher:
         chosen = [c for c, sock in zip(connections, sockets) if sock in ready]
         self.skipped += len(connections) - len(chosen)
         self._write(impl, msg, chosen)
+
+    def _set_no_delay(self, connections):
+        present = set()
+        for connection in connections:
+            present.add(id(connection))
+            if id(connection) not in self._no_delay:
+                try:
+                    connection.socket.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                except (AttributeError, OSError):
+                    pass                  # closing: rospy drops it
+        self._no_delay = present
 
     @staticmethod
     def _write(impl, msg, connections):

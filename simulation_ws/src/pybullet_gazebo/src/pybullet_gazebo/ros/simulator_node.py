@@ -91,8 +91,10 @@ class SimulatorNode:
             own = rospy_hooks.install(report=False)
             self.board = Board(rospy.get_name(), own.counts, ServiceProviders(rospy.get_name()))
             own.on_change = self.board.notify
+            # no Nagle on the reports: a report held back for the last one's ACK would hold
+            # the simulation for the receiver's delayed ACK
             self._report_sub = rospy.Subscriber(REPORT_TOPIC, LockstepReport, self._on_report,
-                                                queue_size=None)
+                                                queue_size=None, tcp_nodelay=True)
         self.lockstep = Lockstep(
             params.lockstep, params.lockstep_timeout, self.board,
             IdleWatch(own_busy=own_receivers.busy, own_moved=own_receivers.moved,
@@ -307,9 +309,9 @@ class SimulatorNode:
             if self._model_states_due():
                 self.state_topics.publish()
             if self._loop_clock is not None and self.lockstep.settled_now():
-                self._hand_on_tick()
-                self._handed_on = True
-                self.lockstep.stats.ticks_while_stepping += 1
+                if self._hand_on_tick():
+                    self._handed_on = True
+                    self.lockstep.stats.ticks_while_stepping += 1
         return []
 
     def _settle_loop_nodes(self):
@@ -333,15 +335,17 @@ class SimulatorNode:
         """The owed /clock tick to the next loop node that has not had it. One node at a
         time, in the order of their names: when one node's tick acts on another (bug 2
         switching go to point on by a service call), which ticks first is then the same on
-        every run, not the machine's choice."""
+        every run, not the machine's choice. True when a tick went out."""
         if self._owed is None:
             self._owed = sorted(self._watched_names)
-        if self._owed:
+        sent = bool(self._owed)
+        if sent:
             self.lockstep.sending()
             self.lockstep.stats.ticks += 1
             self.clock_pub.publish_to_loop_nodes(self._loop_clock, {self._owed.pop(0)})
         if not self._owed:
             self._loop_clock = self._owed = None
+        return sent
 
     def _watch_loop_nodes(self):
         """Lockstep waits for the loop nodes: by their reports when they send them (the

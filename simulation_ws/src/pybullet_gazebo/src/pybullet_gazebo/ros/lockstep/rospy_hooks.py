@@ -42,6 +42,7 @@ def install(report=True):
     if TRACKER is not None:
         if not report:
             TRACKER.reporting = lambda: False
+            TRACKER.counting_only = True
         return TRACKER
     import genpy
     import rospy
@@ -52,12 +53,12 @@ def install(report=True):
     from rospy.impl import tcpros_base, tcpros_pubsub, tcpros_service
 
     tracker = TRACKER = Tracker(send=_send, reporting=_reporting if report else lambda: False)
+    tracker.counting_only = not report
     get_ident = threading.get_ident
-    queued = weakref.WeakSet()
+    waiting = weakref.WeakSet()          # queued connections with messages not yet written
 
     def pending_writes():
-        return sum(getattr(q, "_lockstep_pending", 0) for q in list(queued)
-                   if not q._connection.done)
+        return any(not q._connection.done for q in list(waiting))
     tracker.pending_writes = pending_writes
 
     # --- taking in ----------------------------------------------------------------------
@@ -107,7 +108,10 @@ def install(report=True):
             return result
         finally:
             if outer is not None:
-                outer._lockstep_pending -= 1
+                with outer._lock:            # the queue's lock: += and -= from two threads
+                    outer._lockstep_pending -= 1
+                    if outer._lockstep_pending <= 0:
+                        waiting.discard(outer)
                 tracker.unqueued()
     tcpros_base.TCPROSTransport.write_data = counted_write_data
 
@@ -118,12 +122,12 @@ def install(report=True):
         queued_init(self, connection, queue_size)
         self._lockstep_pending = 0
         connection._lockstep_queue = self
-        queued.add(self)
 
     def counted_queued_write(self, data):
         with self._lock:
             if not (self._queue_size > 0 and len(self._queue) == self._queue_size):
                 self._lockstep_pending += 1     # (a full queue drops its oldest: no change)
+                waiting.add(self)
         return queued_write(self, data)
     tcpros_pubsub.QueuedConnection.__init__ = tracked_queued_init
     tcpros_pubsub.QueuedConnection.write_data = counted_queued_write

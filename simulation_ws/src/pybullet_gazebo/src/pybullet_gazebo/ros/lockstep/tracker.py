@@ -51,7 +51,10 @@ class Tracker:
         self._called = []                 # [(service, port)] made since the last report
         self._news = False                # something to report once done
         self.seq = 0
-        self.on_change = None             # called (no lock held) when counts change
+        self.on_change = None             # called (no lock held) when `taken` grows
+        # the simulator's own process counts what it takes in and writes, nothing more: its
+        # loop polls rospy.is_shutdown() and must not be taken for a busy loop
+        self.counting_only = False
 
     # --- what the hooks say ------------------------------------------------------------
     def callback_started(self):
@@ -69,6 +72,8 @@ class Tracker:
             self._running -= 1
             self._wake_pollers()
         self._after_change()
+        if self.on_change is not None:
+            self.on_change()
 
     def dropped(self, topic, port, count):
         """A subscriber's queue_size dropped `count` messages unread: they are done with."""
@@ -89,6 +94,8 @@ class Tracker:
         self._after_change()
 
     def call_started(self, tid):
+        if self.counting_only:
+            return
         with self._lock:
             self._calls += 1
             self._last[tid] = _OTHER
@@ -99,6 +106,8 @@ class Tracker:
                 self._called.append((service, port))
 
     def call_ended(self, tid):
+        if self.counting_only:
+            return
         with self._lock:
             self._calls -= 1
             self._wake_pollers()
@@ -109,14 +118,14 @@ class Tracker:
             key = (topic, peer, port)
             self.written[key] = self.written.get(key, 0) + 1
             self._news = True
-        if self.on_change is not None:
-            self.on_change()
 
     def unqueued(self):
         """A queued connection wrote a message (pending_writes() fell)."""
         self._after_change()
 
     def published(self, tid):
+        if self.counting_only:
+            return
         with self._lock:
             self._last[tid] = _OTHER
 
@@ -150,6 +159,8 @@ class Tracker:
     def polled(self, tid):
         """Thread `tid` called rospy.is_shutdown(); a second call with nothing between makes
         it a poller: done, and held (while reporting) until something happens."""
+        if self.counting_only:
+            return
         with self._lock:
             if self._last.get(tid) != _POLL:
                 self._last[tid] = _POLL
@@ -209,14 +220,14 @@ class Tracker:
             self._changed.notify_all()          # is a second one in a row: done again)
 
     def _after_change(self):
+        if self.counting_only:
+            return
         report = None
         with self._lock:
             if self._news and self._done() and self.reporting():
                 report = self._report()
         if report is not None:
             self.send(report)
-        if self.on_change is not None:
-            self.on_change()
 
     def _report(self):
         self._news = False
