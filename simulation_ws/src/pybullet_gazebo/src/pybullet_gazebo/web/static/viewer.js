@@ -311,7 +311,7 @@
     });
   }
 
-  function fmt(v, d) { return (v < 0 ? '' : ' ') + v.toFixed(d); }
+  function fmt(v, d) { return ' ' + v.toFixed(d); }
 
   function showStatus(frame, extra) {
     if (!frame) { return; }
