@@ -8,7 +8,11 @@ turned by the distance each rolled, its laser cast there (the sensor's own caste
 model: the scan it would have taken at that pose; the world's dynamic models where the
 scene has them). Frames as the live page gets them (pybullet_gazebo.web.frames).
 
+  build(scene, urdf_xml, track, title)                 -> the replay (a JSON-able dict)
   write(folder, name, scene, urdf_xml, track, title)   -> <folder>/<name>.html
+
+The batch runner (rig.py, RunOptions.replay) keeps a run's replay as runs/<run_id>.replay.json;
+the grader's report turns each into a page beside the run's picture (grade/report.py).
 """
 import numpy as np
 
@@ -67,6 +71,11 @@ class _Wheels:
             now.append(position)
         self.last = now
 
+    def straighten(self):
+        """Every wheel back at angle 0 (the scene serves other measures after)."""
+        for joint, _, _, _ in self.wheels:
+            self.client.resetJointState(self.robot.body_id, joint, 0.0)
+
 
 def frames(scene, track, robot_links, period=FRAME_PERIOD, hits=REPLAY_HITS):
     """The replay's frames from `track` rows (t, x, y, z, qx, qy, qz, qw) in `scene`;
@@ -92,14 +101,19 @@ def frames(scene, track, robot_links, period=FRAME_PERIOD, hits=REPLAY_HITS):
         if lasers:
             frame["hits"][robot.name] = {"from": origin, "points": points}
         out.append(frame)
+    wheels.straighten()
     return out
+
+
+def build(scene, urdf_xml, track, title):
+    """The replay of `track` in `scene` (see site.py for its fields)."""
+    robot = robot_scene(scene.robot.name, urdf_xml)
+    return {"title": title, "scene": world_scene(scene.spec, inline_meshes=True),
+            "robots": {scene.robot.name: robot},
+            "frames": frames(scene, track, robot["links"])}
 
 
 def write(folder, name, scene, urdf_xml, track, title):
     """Writes the replay's page and data into `folder` (site.write_replay); returns the
     page's path."""
-    robot = robot_scene(scene.robot.name, urdf_xml)
-    replay = {"title": title, "scene": world_scene(scene.spec, inline_meshes=True),
-              "robots": {scene.robot.name: robot},
-              "frames": frames(scene, track, robot["links"])}
-    return site.write_replay(folder, name, replay)
+    return site.write_replay(folder, name, build(scene, urdf_xml, track, title))
