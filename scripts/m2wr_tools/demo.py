@@ -1,7 +1,7 @@
 """The tutorial's episode 5, end to end: m2wr in world02 driven by obstacle_avoidance.py.
 
   scripts/demo.sh [--world world02] [--x 0 --y 8 --yaw 0] [--duration 120] [--seed 0]
-                  [--gui] [--web [--web-port 8090]] [--realtime] [--bag] [--output output/]
+                  [--gui] [--web [--web-port 8090] [--web-host 127.0.0.1]] [--realtime] [--bag] [--output output/]
 
 Steps: its own ROS master on a free localhost port -> `roslaunch my_worlds
 launch_world.launch` (paused; headless, real_time_factor 0 and lockstep unless --realtime or
@@ -62,6 +62,9 @@ def parse_args(argv):
                         "(no display needed); runs at real time")
     parser.add_argument("--web-port", type=int, default=8090,
                         help="TCP port of the live page with --web (default 8090)")
+    parser.add_argument("--web-host", default="127.0.0.1",
+                        help="address of the live page with --web (default 127.0.0.1, this "
+                        "machine only; 0.0.0.0 in a container whose port is published)")
     parser.add_argument("--realtime", action="store_true",
                         help="run at real time (real_time_factor 1, no lockstep) instead of "
                         "as fast as possible in lockstep")
@@ -116,9 +119,11 @@ def run(args, session, paths):
     session.start_episode(args.world, (args.x, args.y, args.yaw), lockstep=not realtime,
                           real_time_factor=1.0 if realtime else 0.0, seed=args.seed,
                           pub_clock_frequency=args.clock_hz, gui=args.gui, say=say,
-                          extra=["web:=true", "web_port:=%d" % args.web_port] if args.web else ())
+                          extra=["web:=true", "web_port:=%d" % args.web_port,
+                                 "web_host:=%s" % args.web_host] if args.web else ())
     if args.web:
-        say("watch it on http://127.0.0.1:%d/" % args.web_port)
+        say("watch it on http://%s:%d/" % ("127.0.0.1" if args.web_host == "0.0.0.0"
+                                           else args.web_host, args.web_port))
     urdf = rospy.get_param(ROBOT_DESCRIPTION_PARAM)
     if args.bag:
         session.start_bag(paths["bag"], BAG_TOPICS)
