@@ -30,6 +30,6 @@ def embed(record, output):
     """The HTML embedding the record's replay page (student pages are in students/), or ""."""
     if not os.path.isfile(os.path.join(output, "runs", record["run_id"] + ".html")):
         return ""
-    return ('<iframe class="replay" src="../runs/%s.html" loading="lazy" width="560" '
+    return ('<iframe class="replay" src="../runs/%s.html" loading="lazy" width="640" '
             'height="%d" title="replay of run %d"></iframe>'
             % (html.escape(record["run_id"]), HEIGHT, record["index"]))

@@ -204,7 +204,7 @@
     var pointsGeometry = new THREE.BufferGeometry();
     pointsGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * 1024), 3));
     pointsGeometry.setDrawRange(0, 0);
-    var points = new THREE.Points(pointsGeometry, new THREE.PointsMaterial({ color: 0xe02020, size: 0.06 }));
+    var points = new THREE.Points(pointsGeometry, new THREE.PointsMaterial({ color: 0xe02020, size: 0.08 }));
     points.frustumCulled = false;
     var raysGeometry = new THREE.BufferGeometry();
     raysGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(6 * 1024), 3));
