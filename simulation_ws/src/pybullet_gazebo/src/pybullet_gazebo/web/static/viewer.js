@@ -69,6 +69,9 @@
       color: new THREE.Color(c[0], c[1], c[2]), transparent: c[3] < 1, opacity: c[3] });
   }
 
+  // for tests and scripts: what was drawn
+  var stats = window.m2wrStats = { meshesLoaded: 0 };
+
   var loaders = {};
   function loaderFor(url) {
     var ext = (url.split('?')[0].split('.').pop() || '').toLowerCase();
@@ -111,6 +114,7 @@
           object = result;
         }
         holder.add(object);
+        stats.meshesLoaded += 1;
       }, undefined, function () {
         problem(what + ' could not be loaded: not drawn');
       });
