@@ -139,8 +139,9 @@
       var size = [Math.min(shape.size[0], 200), Math.min(shape.size[1], 200)];
       object = new THREE.Mesh(new THREE.PlaneBufferGeometry(size[0], size[1]),
                               material(shape.colour));
-      var grid = new THREE.GridHelper(Math.min(size[0], size[1]), Math.min(size[0], size[1]),
-                                      0x999999, 0xaaaaaa);
+      // 1 m cells over the middle 20 m (over the whole plane they alias into stripes)
+      var cells = Math.min(size[0], size[1], 20);
+      var grid = new THREE.GridHelper(cells, cells, 0x9c9c9c, 0xa8a8a8);
       grid.rotation.x = Math.PI / 2;
       grid.position.z = 0.002;
       object.add(grid);
