@@ -44,6 +44,7 @@ def world(tmp_path_factory):
     session = Session(str(logs / "logs"), name="test_web_view")
     port = processes.free_port()
     probe = None
+    saved = {k: os.environ.get(k) for k in ("ROS_MASTER_URI", "ROS_HOSTNAME")}
     try:
         uri = session.start_master()
         os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
@@ -61,6 +62,11 @@ def world(tmp_path_factory):
             probe.terminate()
             probe.wait(10)
         session.stop_all()
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
 
 
 @pytest.fixture(scope="module")
