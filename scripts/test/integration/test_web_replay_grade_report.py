@@ -3,10 +3,9 @@ from file:// in Debian's chromium (Playwright) with no network: the replay's pag
 inside the student page with no console error and shows m2wr where the run's track ends.
 The run's replay is made as the batch runner makes it (m2wr_tools.replays.build on the
 offline scene), from a track written here (m2wr along world02's north corridor), so no
-simulation runs. A screenshot goes to docs/web_grade_student.png with M2WR_SCREENSHOTS=1."""
+simulation runs."""
 import json
 import math
-import os
 import re
 
 import pytest
@@ -91,9 +90,6 @@ def test_a_students_page_embeds_its_runs_replay(site):
             x, y = map(float, ROBOT.search(inner.inner_text("#status")).groups())
             assert abs(x - last[1]) < 0.01 and abs(y - last[2]) < 0.01, (x, y, last)
             assert inner.inner_text("#problems") == ""
-            if os.environ.get("M2WR_SCREENSHOTS"):
-                inner.evaluate("() => window.m2wrReplay.seek(window.m2wrReplay.end * 0.8)")
-                page.screenshot(path=os.path.join(paths.ROOT, "docs", "web_grade_student.png"))
         finally:
             browser.close()
     assert errors == []
