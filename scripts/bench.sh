@@ -3,6 +3,9 @@
 #   scripts/bench.sh [--seconds 15] [--soak MINUTES] [--clock-hz 20] [--output output/]
 #   scripts/bench.sh --listeners-only ROUNDS [--seconds 15] [--watch-rate HZ]
 #     only the lockstep loop without and with listeners, in turn (ratio per round, median)
+#   scripts/bench.sh --web-only ROUNDS [--pages 1] [--seconds 15]
+#     only the lockstep loop without and with the live web page (web:=true) watched by
+#     --pages pages, in turn (ratio per round, median; target >= 90 %)
 #   scripts/bench.sh --loop-program-only [ROUNDS] [--seconds 15]
 #     obstacle_avoidance.py and the same rules on a rospy.Rate loop, in lockstep, in turn
 #     ROUNDS times (default 3) at /clock 20 and 100 Hz: their ratio per round, median

@@ -41,6 +41,10 @@ APT_PACKAGES=(
   rviz python3-rviz
   # the grader's report opened in a real browser by its test (headless, through Playwright)
   chromium
+  # the browser view (web:=true, replays): three.js r111 with its classic-script loaders and
+  # OrbitControls (a replay opens from file://, where ES modules cannot load), and aiohttp,
+  # the HTTP + WebSocket server of the simulator's page
+  libjs-three python3-aiohttp
 )
 
 STEP="check machine"

@@ -4,6 +4,7 @@ obstacle_avoidance.py), printed side by side and written to <output>/bench.json.
   scripts/bench.sh [--seconds 15] [--soak MINUTES] [--clock-hz 20] [--output output/]
   scripts/bench.sh --listeners-only ROUNDS [--seconds 15] [--watch-rate HZ]
   scripts/bench.sh --loop-program-only [ROUNDS] [--seconds 15]
+  scripts/bench.sh --web-only ROUNDS [--pages 1] [--seconds 15]
 
 Figures:
   whole loop        real-time factor of simulator + obstacle_avoidance.py, headless, with
@@ -53,6 +54,8 @@ Figures:
                     turn: each round's ratio and the median, CPU per sim s of the simulator,
                     the controller and each listener (the most robust figure on a shared
                     machine: compare the listeners' CPU between builds)
+  --web-only        the lockstep loop without and with the live web page (web:=true) and
+                    --pages pages watching it, ROUNDS times in turn (m2wr_tools.bench_web)
 The machine is shared: the load average before and after is recorded with the figures.
 
 Where the simulator's time goes (profile recipe): run the loop (scripts/demo.sh, or
@@ -328,6 +331,12 @@ def parse_args(argv):
                              "obstacle_avoidance.py beside a busy loop in lockstep, in turn, "
                              "ROUNDS times (default 3) at --clock-hz and at 100 Hz: each "
                              "round's ratios and their medians (targets >= 0.9 and >= 0.8)")
+    parser.add_argument("--web-only", type=int, default=0, metavar="ROUNDS",
+                        help="only the lockstep loop without and with the live web page watched "
+                             "by --pages pages, ROUNDS times in turn (ratio per round, median; "
+                             "target >= 90 %%)")
+    parser.add_argument("--pages", type=int, default=1,
+                        help="with --web-only: pages watching at once (default 1)")
     parser.add_argument("--watch-rate", type=float, default=None, metavar="HZ",
                         help="with --listeners-only: the simulator's ~watch_rate (default: its "
                              "own, 30)")
@@ -368,7 +377,7 @@ def main(argv=None):
                "world": WORLD, "start": dict(zip(("x", "y", "yaw"), START)), "loop": {}}
 
     def bench():
-        if not (args.listeners_only or args.loop_program_only):
+        if not (args.listeners_only or args.loop_program_only or args.web_only):
             say("engine alone (no ROS)")
             figures["engine"] = engine_figures()
             say("  stepSimulation %.1fx, World.step %.1fx real time, scan %.3f ms" % (
@@ -380,7 +389,10 @@ def main(argv=None):
         import rospy
         rospy.init_node("m2wr_bench", disable_signals=True)
         listener = Listener()
-        if args.listeners_only:
+        if args.web_only:
+            from .bench_web import web_rounds
+            figures["web_rounds"] = web_rounds(session, listener, args)
+        elif args.listeners_only:
             figures["listener_rounds"] = listener_rounds(session, listener, args)
         elif args.loop_program_only:
             figures["loop_program_rounds"] = loop_program_rounds(session, listener, args)
@@ -399,6 +411,9 @@ def main(argv=None):
         json.dump(figures, dump, indent=2, default=str)
     if figures.get("listener_rounds"):
         print(rounds_report(figures), flush=True)
+    if figures.get("web_rounds"):
+        from .bench_web import web_report
+        print(web_report(figures), flush=True)
     if "engine" in figures:
         print(report(figures) if figures["loop"] else "", flush=True)
     elif figures.get("loop_program_rounds"):

@@ -1,15 +1,17 @@
 """The tutorial's episode 5, end to end: m2wr in world02 driven by obstacle_avoidance.py.
 
   scripts/demo.sh [--world world02] [--x 0 --y 8 --yaw 0] [--duration 120] [--seed 0]
-                  [--gui] [--realtime] [--bag] [--output output/]
+                  [--gui] [--web [--web-port 8090] [--web-host 127.0.0.1]] [--realtime] [--bag] [--output output/]
 
 Steps: its own ROS master on a free localhost port -> `roslaunch my_worlds
 launch_world.launch` (paused; headless, real_time_factor 0 and lockstep unless --realtime or
---gui, which run at real time) -> `roslaunch m2wr_description spawn.launch x:= y:= yaw:=` ->
+--gui or --web, which run at real time) -> `roslaunch m2wr_description spawn.launch x:= y:= yaw:=` ->
 `rosrun motion_plan obstacle_avoidance.py` (the tutorial's program, unchanged) -> physics
 unpaused for --duration seconds of sim time, with a progress line every ~2 s of wall time ->
 physics paused, everything stopped (SIGINT, then SIGTERM/SIGKILL; no process left behind) ->
-a top-down picture <output>/demo_<world>.png, a summary printed and written to
+a top-down picture <output>/demo_<world>.png, a replay of the run in the browser view
+<output>/demo_<world>_replay.html (opens from disk: the robot, its path and its laser over a
+time slider; m2wr_tools.replays), a summary printed and written to
 <output>/demo_<world>.json, and with --bag <output>/demo_<world>.bag (/m2wr/laser/scan,
 /odom, /cmd_vel). Child logs and ROS logs go to <output>/logs/demo/.
 
@@ -55,6 +57,14 @@ def parse_args(argv):
     parser.add_argument("--seed", type=int, default=0, help="seed of the laser noise (default 0)")
     parser.add_argument("--gui", action="store_true",
                         help="open pybullet's window (needs a display); runs at real time")
+    parser.add_argument("--web", action="store_true",
+                        help="watch the run live in a browser on http://127.0.0.1:WEB_PORT/ "
+                        "(no display needed); runs at real time")
+    parser.add_argument("--web-port", type=int, default=8090,
+                        help="TCP port of the live page with --web (default 8090)")
+    parser.add_argument("--web-host", default="127.0.0.1",
+                        help="address of the live page with --web (default 127.0.0.1, this "
+                        "machine only; 0.0.0.0 in a container whose port is published)")
     parser.add_argument("--realtime", action="store_true",
                         help="run at real time (real_time_factor 1, no lockstep) instead of "
                         "as fast as possible in lockstep")
@@ -95,7 +105,7 @@ def run(args, session, paths):
     from .gazebo import call_empty, model_poses
     from .recorder import Recorder
 
-    realtime = args.realtime or args.gui
+    realtime = args.realtime or args.gui or args.web
     say("starting a ROS master on a free port")
     uri = session.start_master()
     os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
@@ -108,7 +118,12 @@ def run(args, session, paths):
                                 else "as fast as possible, lockstep"))
     session.start_episode(args.world, (args.x, args.y, args.yaw), lockstep=not realtime,
                           real_time_factor=1.0 if realtime else 0.0, seed=args.seed,
-                          pub_clock_frequency=args.clock_hz, gui=args.gui, say=say)
+                          pub_clock_frequency=args.clock_hz, gui=args.gui, say=say,
+                          extra=["web:=true", "web_port:=%d" % args.web_port,
+                                 "web_host:=%s" % args.web_host] if args.web else ())
+    if args.web:
+        say("watch it on http://%s:%d/" % ("127.0.0.1" if args.web_host == "0.0.0.0"
+                                           else args.web_host, args.web_port))
     urdf = rospy.get_param(ROBOT_DESCRIPTION_PARAM)
     if args.bag:
         session.start_bag(paths["bag"], BAG_TOPICS)
@@ -161,7 +176,7 @@ def _wait_for_bag(session, timeout=15.0):
 def analyse(args, data, paths):
     """The offline part: clearance, picture, summary."""
     import numpy as np
-    from . import picture
+    from . import picture, replays
     from .scene import Scene
     from pybullet_gazebo.engine.transforms import Pose
 
@@ -189,6 +204,10 @@ def analyse(args, data, paths):
             beams = picture.beam_segments(sensor.position[:2], sensor.rpy[2], scan.angle_min,
                                           scan.angle_increment, scan.ranges)
         outlines = scene.outlines(SCAN_HEIGHT)
+        replay = replays.write(os.path.dirname(paths["replay"]),
+                               os.path.basename(paths["replay"])[:-len(".html")], scene,
+                               data["urdf"], track, "%s: m2wr, obstacle_avoidance.py" % (
+                                   world_label(args.world)))
     finally:
         scene.close()
     title = "%s: m2wr from (%.2f, %.2f) m, yaw %.0f deg; obstacle_avoidance.py for %.0f s sim" % (
@@ -201,7 +220,11 @@ def analyse(args, data, paths):
         wall_time=data["wall"], distance=summary.distance_travelled(track[:, 1:3]),
         collisions=collisions,
         cases=summary.case_durations(recorder.cases, start, end), picture=paths["picture"],
-        bag=paths["bag"] if args.bag else "")
+        bag=paths["bag"] if args.bag else "", replay=replay)
+    end_pose = data["poses"].get(scene.robot_name)
+    if end_pose is not None:
+        result.end = (float(end_pose.position[0]), float(end_pose.position[1]),
+                      float(end_pose.rpy[2]))
     if nearest is not None and math.isfinite(nearest.distance):
         result.min_clearance = nearest.distance
         result.min_clearance_model = nearest.model
@@ -220,7 +243,8 @@ def main(argv=None):
         return 1
     paths = {"picture": os.path.join(out, "demo_%s.png" % label),
              "summary": os.path.join(out, "demo_%s.json" % label),
-             "bag": os.path.join(out, "demo_%s.bag" % label)}
+             "bag": os.path.join(out, "demo_%s.bag" % label),
+             "replay": os.path.join(out, "demo_%s_replay.html" % label)}
     session = Session(os.path.join(out, "logs", "demo"), name="m2wr_demo")
 
     raise_on_signals()

@@ -97,6 +97,9 @@ def parse_args(argv):
     parser.add_argument("--bag", action="store_true", help="a rosbag per run in <output>/runs/")
     parser.add_argument("--pictures", action="store_true",
                         help="the demo's picture per run in <output>/runs/")
+    parser.add_argument("--replays", action="store_true",
+                        help="a replay per run in the browser view, <output>/runs/<run>.html "
+                        "(opens from disk: the robot, its path and laser over a time slider)")
     parser.add_argument("--fresh", action="store_true",
                         help="ignore the runs already in <output>/results.json")
     parser.add_argument("--connect-timeout", type=float, default=20.0,
@@ -228,6 +231,15 @@ def report(args, records, outlines_of, scenarios):
             runs, title))
     for path in pictures:
         say("picture %s" % path)
+    replays = [r for r in records if r.get("replay") and os.path.isfile(r["replay"])]
+    if replays:
+        import json
+        from pybullet_gazebo.web import site
+        for r in replays:
+            with open(r["replay"]) as source:
+                site.write_replay(os.path.join(args.output, "runs"), r["run_id"],
+                                  json.load(source))
+        say("replays: %d pages %s" % (len(replays), os.path.join(args.output, "runs", "*.html")))
     say("results %s and results.csv" % os.path.join(args.output, "results.json"))
 
 
@@ -453,7 +465,8 @@ def evaluate(args):
         len(scenarios), len(args.world), len(scenarios) // max(1, len(args.world) * len(args.seeds)),
         len(args.seeds), args.duration))
     options = RunOptions(output=args.output, reuse=not args.no_reuse, bag=args.bag,
-                         picture=args.pictures, connect_timeout=args.connect_timeout,
+                         picture=args.pictures, replay=args.replays,
+                         connect_timeout=args.connect_timeout,
                          run_timeout=args.run_timeout, warm_start=not args.cold_start)
     records = run_batch(scenarios, options, scheduler=args.scheduler, workers=args.workers,
                         resume=not args.fresh, progress=not args.no_progress, say=say)

@@ -88,6 +88,7 @@ class RunOptions:
     run_timeout: float = 0.0          # [s wall] per run; 0: 60 + 2 x duration
     bag: bool = False                 # rosbag per run: runs/<run_id>.bag
     picture: bool = False             # the demo's picture per run: runs/<run_id>.png
+    replay: bool = False              # the run's replay (browser view): runs/<run_id>.replay.json
     batch: str = ""                   # the batch's tag (BATCH_TAG in every child's environment)
     warm_start: bool = True           # fork Python controllers from a warm zygote (m2wr_tools.zygote)
     gui: bool = False                 # the simulator's window (replays); headless by default
@@ -595,7 +596,24 @@ class Rig:
             result["bag"] = os.path.join(runs_dir, scenario.run_id + ".bag")
         if options.picture:
             result["picture"] = self._picture(scenario, track, scene, runs_dir)
+        if options.replay:
+            result["replay"] = self._replay(scenario, track, scene, runs_dir)
         return result
+
+    def _replay(self, scenario, track, scene, runs_dir):
+        import json
+        import rospy
+        from . import replays
+        path = os.path.join(runs_dir, scenario.run_id + ".replay.json")
+        rows = np.concatenate([track[:, :3], track[:, 4:9]], axis=1)   # t x y z q (no yaw)
+        replay = replays.build(scene, rospy.get_param(ROBOT_DESCRIPTION_PARAM), rows,
+                               "%s: %s from (%.2f, %.2f), seed %d" % (
+                                   scenario.world_label,
+                                   os.path.basename(scenario.controller[-1]), scenario.x,
+                                   scenario.y, scenario.seed))
+        with open(path, "w") as out:
+            json.dump(replay, out, separators=(",", ":"))
+        return path
 
     def _picture(self, scenario, track, scene, runs_dir):
         from . import picture

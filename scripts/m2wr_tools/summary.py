@@ -111,6 +111,8 @@ class RunSummary:
     cases: Dict[str, float] = field(default_factory=dict)   # case -> [s]
     picture: str = ""
     bag: str = ""
+    replay: str = ""                       # the run's replay page (browser view)
+    end: Optional[Tuple[float, float, float]] = None   # x [m], y [m], yaw [rad] at the end
 
     @property
     def real_time_factor(self):
@@ -127,6 +129,9 @@ class RunSummary:
             "collisions": [{"sim_time_s": c.sim_time, "robot": c.robot, "model": c.model}
                            for c in self.collisions],
             "cases_s": self.cases, "picture": self.picture, "bag": self.bag,
+            "replay": self.replay,
+            "end": None if self.end is None else {"x": self.end[0], "y": self.end[1],
+                                                  "yaw": self.end[2]},
         }
 
     def text(self) -> str:
@@ -156,6 +161,8 @@ class RunSummary:
             lines.append("    (obstacle_avoidance.py logged no case)")
         if self.picture:
             lines.append("  picture           %s" % self.picture)
+        if self.replay:
+            lines.append("  replay            %s (opens in a browser)" % self.replay)
         if self.bag:
             lines.append("  bag               %s" % self.bag)
         return "\n".join(lines)

@@ -128,7 +128,8 @@ def grade_class(spec, submissions, args, say):
                            warm_start=not getattr(args, "cold_start", False),
                            shadowed=shadowed, cpu_s=spec.limits.cpu_s,
                            memory_mib=spec.limits.memory_mib,
-                           processes=spec.limits.processes, file_mib=spec.limits.file_mib)
+                           processes=spec.limits.processes, file_mib=spec.limits.file_mib,
+                           replay=True)
     records = run_batch(todo, options, scheduler=args.scheduler, workers=args.workers,
                         resume=not args.fresh, progress=not args.no_progress, say=say,
                         task=grade_run, on_record=progress) if todo else []

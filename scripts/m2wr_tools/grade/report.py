@@ -13,7 +13,7 @@ import math
 import os
 
 from ..processes import log_tail
-from . import scoring
+from . import replay_view, scoring
 
 STYLE = """body{font-family:sans-serif;margin:1.5em;color:#222}
 table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:.25em .5em;text-align:left}
@@ -109,7 +109,7 @@ def _number(value, unit=""):
     return ("%.2f %s" % (value, unit)).strip() if isinstance(value, float) else str(value)
 
 
-def _student_page(spec, student, entry, row):
+def _student_page(spec, student, entry, row, output=None):
     sub = entry["submission"]
     parts = ['<p><a href="../index.html">class table</a></p>',
              "<h1>%s</h1>" % html.escape(student),
@@ -130,6 +130,8 @@ def _student_page(spec, student, entry, row):
         for r in runs:
             picture = ('<img src="../runs/%s.svg" alt="trajectory of run %d">'
                        % (html.escape(r["run_id"]), r["index"]))
+            if output is not None:
+                picture += replay_view.embed(r, output)
             metrics = "".join("<tr><td>%s</td><td>%s</td></tr>" % (k, html.escape(v)) for k, v in (
                 ("start", "(%.2f, %.2f, %.2f rad), seed %d" % (r["x"], r["y"], r["yaw"],
                                                               r["seed"])),
@@ -201,8 +203,9 @@ def write(output, spec, graded):
         for r in entry["records"]:
             _write(os.path.join(output, "runs", r["run_id"] + ".svg"),
                    svg(_outlines(worlds[r["task"]]), r, goals.get(r["task"])))
+        replay_view.write_replays(output, entry["records"])
         _write(os.path.join(output, "students", row["student"] + ".html"),
-               _student_page(spec, row["student"], entry, row))
+               _student_page(spec, row["student"], entry, row, output))
     _write(os.path.join(output, "index.html"), _index(spec, table_rows))
     _write(os.path.join(output, "grades.csv"), scoring.csv_text(spec, graded))
     data = {"spec": spec.path, "points": spec.points,

@@ -29,6 +29,10 @@ parameters (~name), with units:
                       series' later programs expect); false: Noetic's, Gazebo's (clockwise)
   contacts            also publish ~contacts (the stand-in's own topic, not Gazebo's): off by
                       default, so the world offers exactly Gazebo's API
+  web                 serve the world live in a browser page (web_adapter.py)
+  web_host            address the page is served on; 127.0.0.1 (this machine only) by default
+  web_port            its TCP port (8090)
+  web_control         the page's Pause, Play, Step and Reset world buttons; false: view only
 Global: /use_sim_time (publish /clock).
 Each value is read with engine.parameters.ParameterReader: a bad one stops the node with a
 message naming the parameter, the value and the allowed range.
@@ -62,6 +66,10 @@ class SimulatorParams:
     debug: bool = False
     legacy_mode: bool = False
     contacts: bool = False
+    web: bool = False
+    web_host: str = "127.0.0.1"
+    web_port: int = 8090
+    web_control: bool = True
 
     @staticmethod
     def from_values(private, use_sim_time=True, where="gazebo"):
@@ -89,6 +97,10 @@ class SimulatorParams:
             debug=read.boolean("debug", d.debug),
             legacy_mode=read.boolean("legacy_mode", d.legacy_mode),
             contacts=read.boolean("contacts", d.contacts),
+            web=read.boolean("web", d.web),
+            web_host=str(read.text("web_host", d.web_host)).strip() or d.web_host,
+            web_port=read.integer("web_port", d.web_port, minimum=1),
+            web_control=read.boolean("web_control", d.web_control),
         )
 
     @staticmethod

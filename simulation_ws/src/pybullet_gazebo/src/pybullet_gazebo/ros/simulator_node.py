@@ -53,6 +53,7 @@ from pybullet_gazebo.ros.own_receivers import OwnReceivers
 from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
 from pybullet_gazebo.ros.state_topics import StateTopics
 from pybullet_gazebo.ros.watch_rate import topic_limit
+from pybullet_gazebo.ros.web_adapter import open_web_view
 
 MAX_STEPS_AHEAD = 50        # physics steps the loop takes at most in one World.advance
 
@@ -128,6 +129,7 @@ class SimulatorNode:
                                                                 params.model_states_rate))
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100,
                                             latch=True) if params.contacts else None
+        self.web = open_web_view(self, params) if params.web else None     # the browser page
         self.services = GazeboServices(self)
         rospy.loginfo("world '%s' loaded from %s: %d models, physics step %.4f s, "
                       "real_time_factor %s (%s)%s", world_spec.name, world_spec.source,
@@ -163,6 +165,8 @@ class SimulatorNode:
             self._bindings[robot.name] = RobotBindings(robot, self._binding_context)
             if self.window is not None:
                 self.window.add_robot(robot, urdf_xml)
+            if self.web is not None:
+                self.web.add_robot(robot, urdf_xml)
         return robot
 
     def delete_model(self, name):
@@ -171,6 +175,8 @@ class SimulatorNode:
             bindings = self._bindings.pop(name, None)
             if self.window is not None:
                 self.window.remove_robot(name)
+            if self.web is not None:
+                self.web.remove_robot(name)
         if bindings is not None:
             bindings.close()
 
@@ -275,6 +281,8 @@ class SimulatorNode:
                 self._publish(readings)
                 if self.window is not None:
                     self.window.after_step(readings)      # a frame at most gui_fps per second
+                if self.web is not None:
+                    self.web.after_step(readings)         # the same for the browser page
             self.pacer.pace(now)
 
     def _command_update_next(self):
@@ -513,6 +521,8 @@ class SimulatorNode:
     def _disconnect(self):
         if self.window is not None:
             self.window.close()
+        if self.web is not None:
+            self.web.close()
         with self.lock:           # a service thread still inside the world finishes first
             try:
                 self.client.disconnect()
