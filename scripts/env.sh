@@ -14,6 +14,8 @@ _m2wr_source
 unset -f _m2wr_source
 export PATH="$_m2wr_root/.venv/bin:$PATH"
 export VIRTUAL_ENV="$_m2wr_root/.venv"
+# this checkout's tools first, whatever checkout the venv's editable install points to
+export PYTHONPATH="$_m2wr_root/scripts${PYTHONPATH:+:$PYTHONPATH}"
 # ROS stays on this machine unless the user already chose otherwise.
 export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
 export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"

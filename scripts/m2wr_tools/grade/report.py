@@ -238,10 +238,11 @@ def _index(spec, table_rows, graded):
                   '<td class="n">%d</td>' % row["rank"],
                   '<td class="why" data-v="%d">%s</td>' % (len(short), why)]
         body.append("<tr>%s</tr>" % "".join(cells))
-    tasks = "".join("<li><b>%s</b> (%g points): <code>%s</code>, %s in %s, %d runs of %g s, "
+    tasks = "".join("<li><b>%s</b> (%g points): <code>%s</code>, %s in %s, %d run%s of %g s, "
                     "legacy_mode %s%s%s</li>"
                     % (html.escape(t.name), t.points, html.escape(" ".join(t.command)), t.kind,
-                       html.escape(t.world), len(t.runs), t.duration,
+                       html.escape(t.world), len(t.runs), "" if len(t.runs) == 1 else "s",
+                       t.duration,
                        str(t.legacy_mode).lower(),
                        (", allows " + ", ".join(t.allow)) if t.allow else "",
                        ", after the start: " + html.escape(", ".join(

@@ -17,6 +17,7 @@ import math
 import re
 
 SEE_LOG = re.compile(r";? see /\S+")
+MISSED = re.compile(r"^did not reach the goal \([^)]*\) within [0-9.]+ m: (.+)$")
 SHORT = 60                     # [characters] of a reason in the class table
 NO_NEARER = 0.2                # [m] a path that never came this much nearer its goal
 AWAY = 120.0                   # [deg] off the goal's bearing at the end: facing away
@@ -45,7 +46,7 @@ def _first_line(record):
 def short_failures(spec, records):
     """[(task name, short reason, full reasons)] of each failed task, in spec order: the
     distinct reasons of its failed runs (first lines, without log paths), the first one cut
-    to SHORT characters at a word, "(N runs)" when more than one run failed and "+N other
+    to SHORT characters at a word (a missed goal: what went wrong, from goal_hint), "(N runs)" when more than one run failed and "+N other
     reasons" when they differ."""
     out = []
     for task in spec.tasks:
@@ -57,6 +58,9 @@ def short_failures(spec, records):
             if _first_line(r) not in reasons:
                 reasons.append(_first_line(r))
         short = reasons[0]
+        missed = MISSED.match(short)
+        if missed:          # the goal's figures are in the task's head: say what went wrong
+            short = "did not reach the goal: " + missed.group(1).split(":")[0]
         if len(short) > SHORT:
             short = short[:SHORT].rsplit(" ", 1)[0].rstrip(",;:") + "\u2026"
         if len(failed) > 1:

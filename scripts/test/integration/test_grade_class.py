@@ -254,7 +254,8 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     index = (output / "index.html").read_text()
     assert "Turning: <b>legacy_mode true" in index
     # one short line per failed task in the table, the whole reason in its tooltip
-    assert 'ep6_go_to_point</a>: did not reach the goal (2.00, 8.00) within 0.30 m:' in index
+    assert 'ep6_go_to_point</a>: did not reach the goal: turned away from the goal</div>' \
+        in index
     assert 'title="did not reach the goal (2.00, 8.00) within 0.30 m: turned away' in index
 
     rows, runs, output = _series_grades(tmp_path, False)
