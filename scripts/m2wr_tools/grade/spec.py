@@ -357,7 +357,7 @@ def _steps(items, bad):
             bad("item %d: `%s` is unknown; a %s item has %s" % (
                 number, unknown[0], kind, ", ".join(STEP_FIELDS[kind])))
         name = item[kind]
-        if not isinstance(name, str) or not re.match(r"^/?[A-Za-z][A-Za-z0-9_/~]*$", name):
+        if not isinstance(name, str) or not re.match(r"^/?[A-Za-z][A-Za-z0-9_/]*$", name):
             bad("item %d: %s %r must be a ROS name such as /go_to_point_switch"
                 % (number, kind, name))
         if kind == "call":
