@@ -105,11 +105,8 @@ def make_class(folder, students):
             # a Gazebo Noetic user's copy: m2wr turns the other way there, so the series'
             # learners negate angular.z (the simulator's default, as the grader runs it)
             body = body.replace('get_param("~turn_sign", 1)', 'get_param("~turn_sign", -1)')
-            # episodes 6 and 7 run them on their own: switched on from the start
-            if script == "go_to_point.py":
-                body = body.replace('get_param("~active", False)', 'get_param("~active", True)')
-            if script == "follow_wall.py":
-                body = body.replace("\nactive_ = False\n", "\nactive_ = True\n")
+            # the behaviours stay switched off at start, as the series' final versions: the
+            # default spec switches them on for episodes 6 and 7 (after_start), bug 2 itself
             path = os.path.join(package, "scripts", script)
             with open(path, "w") as out:
                 out.write(body)

@@ -291,3 +291,129 @@ def test_the_call_log_is_read_line_by_line_from_where_the_last_read_stopped(tmp_
     assert gazebo_calls.called([first, second], "/gazebo/set_model_state", by="/bug2")
     assert not gazebo_calls.called([first], "/gazebo/set_model_state", not_by="/bug2")
     assert not gazebo_calls.called([second], "/gazebo/set_model_state")
+
+
+SERIES_CLASS = os.path.join(os.path.dirname(__file__), "fixtures", "series_class")
+
+
+def test_legacy_mode_and_after_start_are_spec_fields_with_defaults(tmp_path):
+    spec = load(_spec(tmp_path, GOOD.replace("version: 1\n", "version: 1\ndefaults:\n"
+                                             "  legacy_mode: true\n").replace(
+        "    duration: 10\n", "    duration: 10\n    legacy_mode: false\n    after_start:\n"
+        "      - call: /go_to_point_switch\n        request: {data: true}\n"
+        "        if_offered: true\n      - param: /my_node/active\n        value: true\n")))
+    avoid, goal = spec.tasks
+    assert (avoid.legacy_mode, goal.legacy_mode) == (False, True)
+    assert spec.legacy_modes == (False, True)
+    call, param = avoid.after_start
+    assert (call.kind, call.name, call.text, call.if_offered, call.wait) == (
+        "call", "/go_to_point_switch", "data: true", True, 2.0)
+    assert call.describe() == 'rosservice call /go_to_point_switch "data: true" (if offered)'
+    assert (param.kind, param.name, param.text) == ("param", "/my_node/active", "true")
+    assert goal.after_start == ()
+    default = load(DEFAULT_SPEC)
+    assert default.legacy_modes == (False,)     # Gazebo Noetic's, as episode 5's page needs
+    switches = {t.name: [s.describe() for s in t.after_start] for t in default.tasks}
+    assert switches["ep6_go_to_point"] == [
+        'rosservice call /go_to_point_switch "data: true" (if offered)']
+    assert switches["ep7_follow_wall"] == [
+        'rosservice call /wall_follower_switch "data: true" (if offered)']
+    assert all(not switches[t] for t in ("ep5_avoid", "ep8_bug0", "ep9_bug1", "ep10_bug2"))
+
+
+@pytest.mark.parametrize("change, message", [
+    ("    legacy_mode: yes please\n", "tasks[1].legacy_mode: 'yes please' must be true"),
+    ("    after_start: {call: /x}\n", "tasks[1].after_start: must be a list of {call:"),
+    ("    after_start:\n      - cal: /x\n", "tasks[1].after_start: item 1 must have one of "
+                                             "`call:` or `param:`"),
+    ("    after_start:\n      - call: /x\n        wiat: 3\n",
+     "tasks[1].after_start: item 1: `wiat` is unknown; a call item has call, request, "
+     "if_offered, wait"),
+    ("    after_start:\n      - param: /x\n", "tasks[1].after_start: item 1: param /x needs "
+                                               "`value:`"),
+    ("    after_start:\n      - call: 'not a name'\n", "item 1: call 'not a name' must be a "
+                                                        "ROS name"),
+])
+def test_a_bad_legacy_mode_or_after_start_names_the_line_and_the_field(tmp_path, change,
+                                                                       message):
+    path = _spec(tmp_path, GOOD.replace("    duration: 10\n", "    duration: 10\n" + change))
+    with pytest.raises(SpecError) as error:
+        load(path)
+    assert message in str(error.value) and "line 7" in str(error.value)
+
+
+def test_a_launch_file_loses_its_world_and_spawn_and_keeps_the_rest(tmp_path):
+    """lee's bug1.launch includes empty_world.launch and spawn.launch; her bug2.launch
+    includes her own world.launch, which includes my_worlds' and runs spawn_model: each is
+    left out, with why, and every node of hers stays."""
+    import shutil
+    import xml.etree.ElementTree as ET
+    from m2wr_tools.grade.launch_filter import SPAWN_WHY, WORLD_WHY, filter_in_place
+    ws = tmp_path / "ws"
+    shutil.copytree(os.path.join(SERIES_CLASS, "lee", "motion_plan"), ws / "motion_plan")
+    packages = {"motion_plan": str(ws / "motion_plan")}
+    bug1 = ws / "motion_plan" / "launch" / "bug1.launch"
+    left = filter_in_place(str(bug1), packages, root=str(ws))
+    assert [(x.file, x.element, x.why) for x in left] == [
+        ("motion_plan/launch/bug1.launch",
+         '<include file="$(find gazebo_ros)/launch/empty_world.launch">', WORLD_WHY),
+        ("motion_plan/launch/bug1.launch",
+         '<include file="$(find m2wr_description)/launch/spawn.launch">', SPAWN_WHY)]
+    root = ET.parse(str(bug1)).getroot()
+    assert [n.get("type") for n in root.iter("node")] == ["follow_wall.py", "go_to_point.py",
+                                                          "bug1.py"]
+    assert [a.get("name") for a in root.findall("arg")] == ["initial_x", "initial_y", "des_x",
+                                                             "des_y"]
+    assert root.find("include") is None and root.find("env") is not None
+    left = filter_in_place(str(ws / "motion_plan" / "launch" / "bug2.launch"), packages,
+                           root=str(ws))
+    assert [(x.file, x.element) for x in left] == [
+        ("motion_plan/launch/world.launch",
+         '<include file="$(find my_worlds)/launch/world.launch">'),
+        ("motion_plan/launch/world.launch", '<param name="robot_description">'),
+        ("motion_plan/launch/world.launch",
+         '<node pkg="gazebo_ros" type="spawn_model" name="mybot_spawn">')]
+    assert left[2].why == SPAWN_WHY
+    world = ET.parse(str(ws / "motion_plan" / "launch" / "world.launch")).getroot()
+    assert [e.tag for e in world] == ["arg"]
+    # a launch file with nothing of the kind is left byte for byte
+    behaviors = os.path.join(SERIES_CLASS, "kim", "motion_plan", "launch", "bug0.launch")
+    shutil.copy(behaviors, ws / "motion_plan" / "launch" / "bug0.launch")
+    before = (ws / "motion_plan" / "launch" / "bug0.launch").read_bytes()
+    assert filter_in_place(str(ws / "motion_plan" / "launch" / "bug0.launch"), packages) == []
+    assert (ws / "motion_plan" / "launch" / "bug0.launch").read_bytes() == before
+
+
+def test_the_class_table_gives_one_short_reason_a_failed_task(tmp_path):
+    spec = load(_spec(tmp_path, GOOD))
+    never = "the controller never published on /cmd_vel; see /out/batch/runs/x.log"
+    records = [{"task": "avoid", "index": 0, "success": False, "reason": never}] + [
+        {"task": "goal", "index": i, "success": False,
+         "reason": "did not reach the goal (0.00, -4.00) within 0.30 m: turned away from the "
+                   "goal: never nearer than at its start (12.00 m), it ended facing 179 deg "
+                   "off the goal's direction"} for i in range(3)] + [
+        {"task": "goal", "index": 3, "success": False, "reason": "controller exited with "
+                                                                  "status 1 while starting"}]
+    short = scoring.short_failures(spec, records)
+    assert short[0] == ("avoid", "the controller never published on /cmd_vel",
+                        ["the controller never published on /cmd_vel"])
+    name, text, full = short[1]
+    assert name == "goal" and len(full) == 2 and full[0].endswith("off the goal's direction")
+    assert text == "did not reach the goal: turned away from the goal (4 runs), +1 other reason"
+
+
+def test_a_goal_run_that_turned_away_is_told_so():
+    # the series' go to point under the other convention: it turns on the spot until it faces
+    # away from the goal, and stays there
+    away = {"x": 0.0, "y": 8.0, "path": [[0, 0.0, 8.0], [5, 0.01, 8.0]], "final_x": 0.01,
+            "final_y": 8.0, "final_yaw": 3.12}
+    assert scoring.goal_hint(away, (2.0, 8.0), False) == (
+        "turned away from the goal: never nearer than at its start (2.00 m), it ended facing "
+        "179 deg off the goal's direction, as a program written for the other turning "
+        "convention does (this task: legacy_mode false)")
+    stuck = dict(away, final_yaw=0.0)
+    assert scoring.goal_hint(stuck, (2.0, 8.0), True) == \
+        "never nearer the goal than at its start (2.00 m)"
+    near = dict(away, path=[[0, 0.0, 8.0], [5, 1.5, 8.0]], final_x=1.0)
+    assert scoring.goal_hint(near, (2.0, 8.0), True) == "came within 0.50 m of it, ended " \
+        "1.00 m away"

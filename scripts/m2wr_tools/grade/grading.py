@@ -82,7 +82,8 @@ def plan(spec, submissions, output):
                     task=Task(kind=task.kind, goal=task.goal, tolerance=task.tolerance,
                               min_distance=task.min_distance),
                     student=sub.student, task_name=task.name, index=index,
-                    packages=staged.get(sub.student, ""), allow=task.allow)
+                    packages=staged.get(sub.student, ""), allow=task.allow,
+                    legacy_mode=task.legacy_mode, after_start=task.after_start)
                 if problem is None:
                     todo.append(scenario)
                 else:

@@ -4,19 +4,25 @@ run, same metrics) with the student's packages resolved first, the run isolated
 
 A GradedScenario is a batch Scenario plus who and what: student, task, run index, the folder
 of the student's staged packages (shared by every worker: under the grader's output), the
-permissions of the task. Its run_id is `<student>__<task>__<index>_<digest>`.
+permissions of the task, its turning convention (legacy_mode, a world launch argument: the
+simulator is relaunched when it changes) and what to do once the controller is up
+(after_start). Its run_id is `<student>__<task>__<index>_<digest>`.
 
 What GradeRig adds to a run:
   before   the packages copied into the run's own folder (sandbox.prepare), the
            controller's environment made from it (classroom.overlay_env: their packages
-           first, `shadowed` names nowhere else) and its command resolved in it
+           first, `shadowed` names nowhere else) and its command resolved in it; a launch
+           file's simulator, world and spawn left out of the run's copy (launch_filter)
+  up       the task's after_start steps (a switch service called, a parameter set), with
+           the world still paused
   start    the controller through prlimit, as the slot's user, in its own process group;
            a Watchdog on its memory that also looks at the master's graph (rules)
   end      every process of the run stopped by PID (the slot user's, or the controller's
            group); the simulator's call log read from where the run began; findings judged:
            a rule broken or the memory limit passed fails the run with that reason
-The record gets: student, task, index, findings (each rule finding), user, isolated,
-memory_peak_mib, leftovers (processes that outlived the controller's stop), grader_s (the
+The record gets: student, task, index, legacy_mode, left_out (what the launch files lost:
+file, element, why), after_start (what each step did, in words), findings (each rule
+finding), user, isolated, memory_peak_mib, leftovers (processes that outlived the controller's stop), grader_s (the
 wall time of what the grader adds around the batch runner's run: files in and out, the end).
 """
 from dataclasses import asdict, dataclass, fields
@@ -28,14 +34,17 @@ import time
 import xmlrpc.client
 from typing import Tuple
 
+import yaml
+
 from .. import gazebo_calls, processes, stale_nodes
 from ..rig import NODE, Rig, RunFailed, RunOptions, run_on
 from ..scenarios import Scenario
-from . import classroom, rules, sandbox
-from .spec import Limits
+from . import classroom, launch_filter, rules, sandbox, scoring
+from .spec import Limits, Step
 
 SET_MODEL_STATE = "/gazebo/set_model_state"
 PLACEMENT_WAIT = 5.0                    # [s] wall: longest wait for a bug program's placement
+CALL_TIMEOUT = 10.0                     # [s] wall: an after_start call's answer, after its wait
 SIMULATOR = "/gazebo"
 
 
@@ -46,6 +55,8 @@ class GradedScenario(Scenario):
     index: int = 0
     packages: str = ""                 # folder of the student's staged packages
     allow: Tuple[str, ...] = ()
+    legacy_mode: bool = False          # the world launch's legacy_mode:= (Kinetic's turning)
+    after_start: Tuple[Step, ...] = ()
 
     @property
     def run_id(self):
@@ -56,6 +67,11 @@ class GradedScenario(Scenario):
         data = super().as_dict()
         data.update(student=self.student, task_name=self.task_name, index=self.index,
                     packages=self.packages, allow=list(self.allow))
+        # only when set: a task without them keeps the run_id (and resume) it had before
+        if self.legacy_mode:
+            data["legacy_mode"] = True
+        if self.after_start:
+            data["after_start"] = [step.as_dict() for step in self.after_start]
         return data
 
     @classmethod
@@ -64,7 +80,8 @@ class GradedScenario(Scenario):
         return cls(**{f.name: getattr(base, f.name) for f in fields(Scenario)},
                    student=data["student"], task_name=data["task_name"],
                    index=int(data["index"]), packages=data["packages"],
-                   allow=tuple(data["allow"]))
+                   allow=tuple(data["allow"]), legacy_mode=bool(data.get("legacy_mode")),
+                   after_start=tuple(Step(**step) for step in data.get("after_start", ())))
 
 
 @dataclass
@@ -90,6 +107,9 @@ class GradeRig(Rig):
     def _call_log(self):
         return os.path.join(self.session.log_dir, gazebo_calls.FILE_NAME)
 
+    def _world_args(self, scenario):
+        return ("legacy_mode:=%s" % str(bool(getattr(scenario, "legacy_mode", False))).lower(),)
+
     def _ensure_simulator(self, scenario, options):
         # set before each (re)launch: a run may have changed the parameter
         self.session.master().setParam(NODE, gazebo_calls.PARAM, self._call_log())
@@ -113,25 +133,44 @@ class GradeRig(Rig):
         # the student's files copied in and removed, the last look, the end by PID
         record["grader_s"] = round(time.monotonic() - began - inner, 3)
         record.update(student=scenario.student, task=scenario.task_name, index=scenario.index,
-                      user=self.slot.name, isolated=sandbox.isolating(),
+                      legacy_mode=scenario.legacy_mode, left_out=current.left_out,
+                      after_start=current.steps, user=self.slot.name,
+                      isolated=sandbox.isolating(),
                       findings=current.findings, memory_peak_mib=current.peak_mib,
                       memory_over=current.watchdog.seen if current.watchdog else "",
                       leftovers=current.leftovers)
         broken = current.watchdog_finding or rules.verdict(current.findings)
         if broken:
             record.update(success=False, reason=broken)
+        elif not record.get("success") and scenario.task.kind == "goal" and "path" in record:
+            hint = scoring.goal_hint(record, scenario.task.goal, scenario.legacy_mode)
+            if hint:
+                record["reason"] = "%s: %s" % (record.get("reason", ""), hint)
         return record
 
     def _resolve(self, argv):
         """`rosrun PKG EXE ARGS` as the executable's path in the student's packages (as
-        rosrun would find it there); anything else as given."""
+        rosrun would find it there); `roslaunch PKG FILE ARGS` as given, its launch file (in
+        the run's copy) without what would touch the grader's world (launch_filter, which
+        the record's left_out lists); anything else as given."""
         argv = tuple(argv)
-        if self.current is not None and len(argv) >= 3 and argv[0] == "rosrun":
-            from ..commands import find_in_package, package_dir
+        if self.current is None or len(argv) < 3:
+            return argv
+        from ..commands import find_in_package, package_dir
+        if argv[0] == "rosrun":
             folder = package_dir(argv[1], self.current.env(self))
             found = find_in_package(folder, argv[2], executable=True) if folder else []
             if found:
                 return (found[0],) + argv[3:]
+        elif argv[0] == "roslaunch":
+            words = [a for a in argv[1:] if not a.startswith("-") and ":=" not in a]
+            folder = package_dir(words[0], self.current.env(self)) if len(words) >= 2 else None
+            ws = os.path.join(self.current.folder, "ws")
+            packages = {name: os.path.join(ws, name) for name in sorted(os.listdir(ws))
+                        if os.path.isfile(os.path.join(ws, name, "package.xml"))}
+            for path in find_in_package(folder, words[1], executable=False) if folder else []:
+                self.current.left_out += [vars(left) for left in launch_filter.filter_in_place(
+                    path, packages, root=ws)]
         return argv
 
     def _start_controller(self, argv, log_path, warm):
@@ -168,6 +207,8 @@ class GradeRig(Rig):
         if run is not None:
             if "set_model_state_to_start" in run.scenario.allow:
                 self._wait_for_placement(run, controller)
+            for step in run.scenario.after_start:
+                run.steps.append(self._after_start(step, controller))
             run.look(self)
             if run.broken:
                 raise RunFailed(rules.verdict(run.findings))
@@ -186,6 +227,49 @@ class GradeRig(Rig):
                 return
             time.sleep(0.02)
 
+    def _after_start(self, step, controller):
+        """Does one after_start step with the world paused (the series' switch, called as its
+        pages call it by hand: `rosservice call /go_to_point_switch "data: true"`); what it
+        did, in words. RunFailed when a call the task needs cannot be made."""
+        import rospy
+        name = step.name if step.name.startswith("/") else "/" + step.name
+        if step.kind == "param":
+            rospy.set_param(name, yaml.safe_load(step.text))
+            return "set the parameter %s to %s" % (name, step.text)
+        deadline = time.monotonic() + step.wait
+        while not self.session.service_offered(name):
+            if time.monotonic() >= deadline or not controller.running():
+                if step.if_offered:
+                    return ("did not call %s: the program offers no such service (it runs "
+                            "as it starts)" % name)
+                raise RunFailed("after start: the program offered no %s within %g s of wall "
+                                "time; the task calls it (%s)" % (name, step.wait,
+                                                                  step.describe()))
+            time.sleep(0.02)
+        answer = {}
+
+        def call():
+            try:
+                import genpy
+                import rosservice
+                kind = rosservice.get_service_class_by_name(name)
+                request = kind._request_class()
+                value = yaml.safe_load(step.text) if step.text.strip() else None
+                genpy.message.fill_message_args(request, [] if value is None else [value])
+                answer["response"] = rospy.ServiceProxy(name, kind)(request)
+            except Exception as err:            # the student's service: any failure is theirs
+                answer["error"] = "%s: %s" % (type(err).__name__, err)
+        caller = threading.Thread(target=call, daemon=True)
+        caller.start()
+        caller.join(step.wait + CALL_TIMEOUT)
+        if caller.is_alive() or "error" in answer:
+            raise RunFailed("after start: %s did not answer %s" % (
+                step.describe(), "within %g s of wall time" % (step.wait + CALL_TIMEOUT)
+                if caller.is_alive() else "(%s)" % answer["error"]))
+        fields = answer["response"].__slots__
+        said = ", ".join("%s: %s" % (f, getattr(answer["response"], f)) for f in fields)
+        return "called %s (%s): %s" % (name, step.text, said[:120] or "answered")
+
     def _stop_controller(self, known_exit):
         if self.current is not None and self.current.watchdog is not None:
             self.current.watchdog.stop()
@@ -203,6 +287,8 @@ class _Run:
     def __init__(self, scenario, options, folder):
         self.scenario, self.options, self.folder = scenario, options, folder
         self.findings, self.seen = [], set()
+        self.left_out = []              # launch_filter.LeftOut as dicts
+        self.steps = []                 # what each after_start step did, in words
         self.broken = False             # a finding no rule allows was seen
         self.watchdog = self.controller = self.master = None
         self.calls_from = None          # the call log's offset the next look reads from

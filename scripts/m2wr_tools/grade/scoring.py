@@ -5,12 +5,22 @@ is the sum, ranks go by total (equal totals share a rank: 1, 2, 2, 4). What a te
                        one column per task, total, max, rank, failures; numbers with two
                        decimals, rows by student name, so grading twice gives the same bytes
   table(spec, graded)  the same as text for the terminal
+  short_failures(spec, records)
+                       the class table's cell: one short line per failed task (its runs'
+                       reasons deduplicated, the first words), with the full text
+  goal_hint(record, goal, legacy_mode)
+                       why a goal run did not get there, from its path, in a teacher's words
 """
 import csv
 import io
+import math
 import re
 
 SEE_LOG = re.compile(r";? see /\S+")
+MISSED = re.compile(r"^did not reach the goal \([^)]*\) within [0-9.]+ m: (.+)$")
+SHORT = 60                     # [characters] of a reason in the class table
+NO_NEARER = 0.2                # [m] a path that never came this much nearer its goal
+AWAY = 120.0                   # [deg] off the goal's bearing at the end: facing away
 
 
 def task_score(task, records):
@@ -26,6 +36,65 @@ def failures(task, records):
     return ["%s run %d: %s" % (task.name, r.get("index", 0), SEE_LOG.sub(
         "", (r.get("reason") or "failed").splitlines()[0]).rstrip(":").rstrip(";"))
             for r in records if not r.get("success")]
+
+
+def _first_line(record):
+    return SEE_LOG.sub("", (record.get("reason") or "failed").splitlines()[0]).rstrip(
+        ":").rstrip(";")
+
+
+def short_failures(spec, records):
+    """[(task name, short reason, full reasons)] of each failed task, in spec order: the
+    distinct reasons of its failed runs (first lines, without log paths), the first one cut
+    to SHORT characters at a word (a missed goal: what went wrong, from goal_hint), "(N runs)" when more than one run failed and "+N other
+    reasons" when they differ."""
+    out = []
+    for task in spec.tasks:
+        failed = [r for r in records if r.get("task") == task.name and not r.get("success")]
+        if not failed:
+            continue
+        reasons = []
+        for r in failed:
+            if _first_line(r) not in reasons:
+                reasons.append(_first_line(r))
+        short = reasons[0]
+        missed = MISSED.match(short)
+        if missed:          # the goal's figures are in the task's head: say what went wrong
+            short = "did not reach the goal: " + missed.group(1).split(":")[0]
+        if len(short) > SHORT:
+            short = short[:SHORT].rsplit(" ", 1)[0].rstrip(",;:") + "\u2026"
+        if len(failed) > 1:
+            short += " (%d runs)" % len(failed)
+        if len(reasons) > 1:
+            short += ", +%d other reason%s" % (len(reasons) - 1, "s" if len(reasons) > 2 else "")
+        out.append((task.name, short, reasons))
+    return out
+
+
+def goal_hint(record, goal, legacy_mode):
+    """Why a goal run that ended short did not get there, from its path and end pose, or "":
+    turned away (never nearer than at its start, ending facing away from the goal: what a
+    program written for the other turning convention does), never nearer, or how near it
+    came."""
+    path = [(p[1], p[2]) for p in record.get("path") or []]
+    end = (record.get("final_x"), record.get("final_y"))
+    if end[0] is None or not path:
+        return ""
+    path.append(end)
+    start = math.hypot(goal[0] - record["x"], goal[1] - record["y"])
+    nearest = min(math.hypot(goal[0] - x, goal[1] - y) for x, y in path)
+    bearing = math.atan2(goal[1] - end[1], goal[0] - end[0])
+    off = abs(math.degrees(math.atan2(math.sin(bearing - record.get("final_yaw", 0.0)),
+                                      math.cos(bearing - record.get("final_yaw", 0.0)))))
+    if nearest > start - NO_NEARER and off > AWAY:
+        return ("turned away from the goal: never nearer than at its start (%.2f m), it ended "
+                "facing %.0f deg off the goal's direction, as a program written for the other "
+                "turning convention does (this task: legacy_mode %s)"
+                % (start, off, str(bool(legacy_mode)).lower()))
+    if nearest > start - NO_NEARER:
+        return "never nearer the goal than at its start (%.2f m)" % start
+    return "came within %.2f m of it, ended %.2f m away" % (
+        nearest, math.hypot(goal[0] - end[0], goal[1] - end[1]))
 
 
 def rows(spec, graded):

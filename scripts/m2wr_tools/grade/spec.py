@@ -29,6 +29,21 @@ field (the default, spec_default.yaml beside this file, says the same in its com
     min_distance          [m] wander/wall: least distance travelled (default 1)
     allow                 extra permissions (m2wr_tools.grade.rules.PERMISSIONS), e.g.
                           [set_model_state_to_start] for the bug programs
+    legacy_mode           false (default): Gazebo Noetic's diff drive, a positive angular.z
+                          turns m2wr clockwise; true: Kinetic's, REP 103 turning (counter-
+                          clockwise), which the series' own programs of episodes 6-10 are
+                          written for. Passed to the world launch as legacy_mode:=
+    after_start           what the grader does once the controller is up, before the world
+                          runs, in order; each item one of
+                            {call: SERVICE, request: "FIELD: VALUE, ...", if_offered: BOOL,
+                             wait: S}   calls SERVICE as `rosservice call SERVICE "REQUEST"`
+                                        would (the type asked of the service); if_offered
+                                        true: a program that does not offer it within `wait`
+                                        [s] of wall time (default 2) is run as it is (the
+                                        page says so); false (default): that fails the run
+                            {param: NAME, value: VALUE}   sets a ROS parameter
+                          e.g. [{call: /go_to_point_switch, request: "data: true",
+                          if_offered: true}], as the series' pages switch go to point on
 
 load(path) -> Spec; SpecError (a ValueError) names the file, the line and the field, and
 says what to write instead.
@@ -48,8 +63,33 @@ from .rules import PERMISSIONS
 DEFAULT_SPEC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "spec_default.yaml")
 NAME = re.compile(r"^[A-Za-z0-9_-]+$")
 TASK_FIELDS = ("name", "command", "kind", "episode", "description", "world", "starts", "seeds",
-               "duration", "points", "goal", "tolerance", "min_distance", "allow")
+               "duration", "points", "goal", "tolerance", "min_distance", "allow",
+               "legacy_mode", "after_start")
+STEP_FIELDS = {"call": ("call", "request", "if_offered", "wait"), "param": ("param", "value")}
+STEP_WAIT = 2.0                 # [s wall] an after_start call waits this long for its service
 LIMIT_FIELDS = ("cpu_s", "memory_mib", "processes", "file_mib")
+
+
+@dataclass(frozen=True)
+class Step:
+    """One thing the grader does after the controller is up (a task's `after_start`).
+    kind "call": `name` is the service, `text` the request as rosservice call's YAML;
+    kind "param": `name` is the parameter, `text` its value as YAML."""
+    kind: str
+    name: str
+    text: str = ""
+    if_offered: bool = False
+    wait: float = STEP_WAIT      # [s wall]
+
+    def as_dict(self):
+        return {"kind": self.kind, "name": self.name, "text": self.text,
+                "if_offered": self.if_offered, "wait": self.wait}
+
+    def describe(self):
+        if self.kind == "call":
+            return 'rosservice call %s "%s"%s' % (self.name, self.text, " (if offered)"
+                                                  if self.if_offered else "")
+        return "rosparam set %s %s" % (self.name, self.text)
 
 
 class SpecError(ValueError):
@@ -80,6 +120,8 @@ class TaskSpec:
     tolerance: float = 0.3        # [m]
     min_distance: float = 1.0     # [m]
     allow: Tuple[str, ...] = ()
+    legacy_mode: bool = False     # the simulator's legacy_mode:= (Kinetic's turning)
+    after_start: Tuple[Step, ...] = ()
 
     @property
     def runs(self):
@@ -97,6 +139,11 @@ class Spec:
     @property
     def points(self):
         return sum(t.points for t in self.tasks)
+
+    @property
+    def legacy_modes(self):
+        """The turning conventions its tasks use, sorted: (False,), (True,) or both."""
+        return tuple(sorted({t.legacy_mode for t in self.tasks}))
 
 
 class _Located(dict):
@@ -272,4 +319,65 @@ def _task(task, defaults, number, fail):
             bad("allow", "%r must be a list of permissions from: %s" % (
                 allow, ", ".join(sorted(PERMISSIONS))))
         values["allow"] = tuple(allow)
+    if "legacy_mode" in merged:
+        if not isinstance(merged["legacy_mode"], bool):
+            bad("legacy_mode", "%r must be true (Kinetic's turning, as the series' code is "
+                "written) or false (Gazebo Noetic's, the default)" % (merged["legacy_mode"],))
+        values["legacy_mode"] = merged["legacy_mode"]
+    if "after_start" in merged:
+        values["after_start"] = _steps(merged["after_start"], lambda what: bad(
+            "after_start", what))
     return TaskSpec(**values)
+
+
+def _plain(value):
+    """`value` with the loader's mappings as plain dicts (for yaml.safe_dump)."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _steps(items, bad):
+    """The Steps of an `after_start` list; bad(what) for anything else."""
+    example = ('e.g. [{call: /go_to_point_switch, request: "data: true", if_offered: true}] '
+               'or [{param: /my_node/active, value: true}]')
+    if not isinstance(items, list):
+        bad("must be a list of {call: SERVICE, request: ...} or {param: NAME, value: ...}, "
+            + example)
+    steps = []
+    for number, item in enumerate(items, 1):
+        kinds = [k for k in STEP_FIELDS if isinstance(item, dict) and k in item]
+        if len(kinds) != 1:
+            bad("item %d must have one of `call:` or `param:`, %s" % (number, example))
+        kind = kinds[0]
+        unknown = sorted(set(item) - set(STEP_FIELDS[kind]))
+        if unknown:
+            bad("item %d: `%s` is unknown; a %s item has %s" % (
+                number, unknown[0], kind, ", ".join(STEP_FIELDS[kind])))
+        name = item[kind]
+        if not isinstance(name, str) or not re.match(r"^/?[A-Za-z][A-Za-z0-9_/]*$", name):
+            bad("item %d: %s %r must be a ROS name such as /go_to_point_switch"
+                % (number, kind, name))
+        if kind == "call":
+            request = item.get("request", "")
+            if isinstance(request, dict):
+                request = yaml.safe_dump(_plain(request), default_flow_style=True,
+                                         sort_keys=True).strip()[1:-1]
+            elif not isinstance(request, str):
+                bad("item %d: request %r must be rosservice call's YAML, e.g. \"data: true\""
+                    % (number, request))
+            if_offered = item.get("if_offered", False)
+            wait = item.get("wait", STEP_WAIT)
+            if not isinstance(if_offered, bool):
+                bad("item %d: if_offered %r must be true or false" % (number, if_offered))
+            if not _number(wait) or wait < 0:
+                bad("item %d: wait %r must be a number of seconds >= 0" % (number, wait))
+            steps.append(Step("call", name, request, if_offered, float(wait)))
+        else:
+            if "value" not in item:
+                bad("item %d: param %s needs `value:`" % (number, name))
+            steps.append(Step("param", name, yaml.safe_dump(
+                _plain(item["value"]), default_flow_style=True).strip().replace("\n...", "")))
+    return tuple(steps)

@@ -62,7 +62,7 @@ def test_the_fixture_class_gets_the_grades_a_teacher_expects(tmp_path):
         return float(r["avoid"]), float(r["goal"]), float(r["total"]), int(r["rank"])
     # ada: a correct avoider and go-to-point: full points, first
     assert grade_of("ada") == (10.0, 10.0, 20.0, 1), rows["ada"]
-    # gus: his launch file spawns m2wr again: refused by the simulator, his avoider graded
+    # gus: his launch file spawns m2wr again: left out, his avoider graded
     assert grade_of("gus") == (10.0, 0.0, 10.0, 2), rows["gus"]
     assert "package 'motion_plan'" in rows["gus"]["failures"] and \
         "has no file 'go_to_point.py'" in rows["gus"]["failures"]
@@ -85,8 +85,11 @@ def test_the_fixture_class_gets_the_grades_a_teacher_expects(tmp_path):
         assert rows[student]["total"] == "0.00" and rows[student]["rank"] == "3"
     data = json.loads((tmp_path / "out" / "results.json").read_text())
     gus = data["students"]["gus"]["runs"][0]
-    assert [f["allowed"] for f in gus["findings"]] == [True] and \
-        "spawn_urdf_model for m2wr" in gus["findings"][0]["what"]
+    # his launch file's spawn is left out (the grader's m2wr is the one graded): no second
+    # spawn reaches the simulator
+    assert gus["findings"] == [] and [x["element"] for x in gus["left_out"]] == [
+        '<param name="robot_description">',
+        '<node pkg="gazebo_ros" type="spawn_model" name="mybot_spawn">']
     fay = next(r for r in data["students"]["fay"]["runs"] if r["task"] == "goal")
     if sandbox.isolating():
         # runs start as the slot's unprivileged user, and the output is the grader's alone
@@ -154,3 +157,112 @@ def test_the_default_spec_grades_a_class_not_written_in_the_series_style(tmp_pat
     assert reasons["fay", "ep6_go_to_point"].startswith("resources: its processes used more "
                                                        "than the 1536 MiB of memory allowed")
     assert "no package.xml and no scripts" in reasons["hal", "ep5_avoid"]
+
+
+SERIES_SPEC = """\
+version: 1
+defaults:
+  world: world02
+  legacy_mode: {legacy_mode}
+tasks:
+  - name: ep6_go_to_point
+    command: rosrun motion_plan go_to_point.py
+    kind: goal
+    starts: [[0, 8, 1.5708]]
+    goal: [2, 8]
+    duration: 30
+    points: 15
+    after_start:
+      - call: /go_to_point_switch
+        request: "data: true"
+        if_offered: true
+  - name: ep7_follow_wall
+    command: rosrun motion_plan follow_wall.py
+    kind: wall
+    duration: 60
+    points: 15
+    after_start:
+      - call: /wall_follower_switch
+        request: "data: true"
+        if_offered: true
+  - name: ep9_bug1
+    command: roslaunch motion_plan bug1.launch initial_x:=0 initial_y:=0 des_x:=7 des_y:=0
+    kind: goal
+    world: {pillar}
+    starts: [[0, 0, 0]]
+    goal: [7, 0]
+    duration: 90
+    points: 15
+    allow: [set_model_state_to_start]
+"""
+PILLAR = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "test", "worlds",
+                      "pillar_on_the_line.world")
+
+
+def _series_grades(tmp_path, legacy_mode):
+    """The series class (fixtures/series_class: kim, the series' final package written for
+    Kinetic's turning; noa, its copy flipped for Noetic's; lee, kim's programs with the
+    world and the robot in her bug1.launch) graded with the spec above; (rows of grades.csv,
+    runs by (student, task), the output folder)."""
+    class_dir = tmp_path / "class"
+    if not class_dir.exists():
+        shutil.copytree(os.path.join(FIXTURES, "series_class"), class_dir)   # links followed
+        os.chmod(class_dir, 0o700)
+    spec = tmp_path / ("series_%s.yaml" % legacy_mode)
+    spec.write_text(SERIES_SPEC.format(legacy_mode=str(legacy_mode).lower(), pillar=PILLAR))
+    output = tmp_path / ("out_%s" % legacy_mode)
+    status, text = grade(class_dir, output, spec=str(spec), timeout=900)
+    assert status == 0, text
+    with open(output / "grades.csv", newline="") as source:
+        rows = {r["student"]: r for r in csv.DictReader(source)}
+    data = json.loads((output / "results.json").read_text())
+    runs = {(s, r["task"]): r for s, student in data["students"].items()
+            for r in student["runs"]}
+    return rows, runs, output
+
+
+def test_the_series_final_packages_are_graded_with_the_turning_they_were_written_for(tmp_path):
+    """The series' final behaviours start switched off: the spec's after_start switches them
+    on as the pages do. Graded with legacy_mode true, kim's package (written for Kinetic's
+    turning) scores go to point, wall following and bug 1; noa's Noetic copy turns away from
+    the goal, and the page says so. lee's bug1.launch starts a world and spawns m2wr: that
+    part is left out, her page says what and why, and her run is kim's to the bit (the
+    grader's world was not touched). With legacy_mode false, the other way round."""
+    rows, runs, output = _series_grades(tmp_path, True)
+    scores = {s: [float(rows[s][t]) for t in ("ep6_go_to_point", "ep7_follow_wall",
+                                              "ep9_bug1")] for s in rows}
+    assert scores["kim"] == [15.0, 15.0, 15.0], rows["kim"]
+    assert scores["lee"] == [15.0, 15.0, 15.0], rows["lee"]
+    assert runs["kim", "ep6_go_to_point"]["after_start"] == [
+        "called /go_to_point_switch (data: true): success: True, message: Done!"]
+    assert runs["noa", "ep6_go_to_point"]["reason"].startswith(
+        "did not reach the goal (2.00, 8.00) within 0.30 m: turned away from the goal")
+    assert runs["noa", "ep6_go_to_point"]["reason"].endswith("(this task: legacy_mode true)")
+    kim, lee = runs["kim", "ep9_bug1"], runs["lee", "ep9_bug1"]
+    assert [(x["element"], x["why"].split(";")[0]) for x in lee["left_out"]] == [
+        ('<include file="$(find gazebo_ros)/launch/empty_world.launch">',
+         "it starts a simulator or a world"),
+        ('<include file="$(find m2wr_description)/launch/spawn.launch">',
+         "it spawns the robot again")]
+    assert kim["left_out"] == []
+    for key in ("path", "time_to_goal_s", "final_x", "final_y", "contact_events"):
+        assert lee[key] == kim[key], key
+    page = (output / "students" / "lee.html").read_text()
+    assert "Left out of the launch files" in page and \
+        "$(find gazebo_ros)/launch/empty_world.launch" in page
+    assert "legacy_mode true: Kinetic&#x27;s diff drive" in page
+    index = (output / "index.html").read_text()
+    assert "Turning: <b>legacy_mode true" in index
+    # one short line per failed task in the table, the whole reason in its tooltip
+    assert 'ep6_go_to_point</a>: did not reach the goal: turned away from the goal</div>' \
+        in index
+    assert 'title="did not reach the goal (2.00, 8.00) within 0.30 m: turned away' in index
+
+    rows, runs, output = _series_grades(tmp_path, False)
+    scores = {s: [float(rows[s][t]) for t in ("ep6_go_to_point", "ep7_follow_wall",
+                                              "ep9_bug1")] for s in rows}
+    assert scores["noa"] == [15.0, 15.0, 15.0], rows["noa"]
+    assert scores["kim"][0] == 0.0 and scores["kim"][2] == 0.0, rows["kim"]
+    assert runs["kim", "ep6_go_to_point"]["reason"].startswith(
+        "did not reach the goal (2.00, 8.00) within 0.30 m: turned away from the goal")
+    assert "Turning: <b>legacy_mode false" in (output / "index.html").read_text()

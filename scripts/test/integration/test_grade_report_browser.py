@@ -1,7 +1,8 @@
 """The grader's report in a real browser: Debian's chromium, headless, driven by Playwright
 for Python (the system browser through executable_path; `playwright install` is never run).
 A report of three students (records written here, no simulation) opens, its class table
-sorts by a column, a student's page opens from it, every picture has loaded, the console
+sorts by every column, gives one short reason a failed task (the full text in its
+tooltip) under a header naming the turning convention, a student's page opens from it, every picture has loaded, the console
 has no error, and a screenshot is saved."""
 import os
 
@@ -79,6 +80,25 @@ def test_the_class_table_sorts_and_a_students_page_shows_its_runs(site, tmp_path
             assert totals() == ["0.00", "10.00", "20.00"] and students() == ["bea", "cat", "abe"]
             page.click("#grades th:nth-child(4)")            # again: descending
             assert students() == ["abe", "cat", "bea"]
+            for column in range(1, 7):                       # every column sorts
+                page.click("#grades th:nth-child(%d)" % column)
+                assert sorted(students()) == ["abe", "bea", "cat"]
+            page.click("#grades th:nth-child(1)")
+            if students() != ["abe", "bea", "cat"]:
+                page.click("#grades th:nth-child(1)")
+            assert students() == ["abe", "bea", "cat"]
+            # one short line per failed task, the whole reason in its tooltip; the header
+            # names the spec and the turning convention
+            reasons = page.eval_on_selector_all(
+                "#grades tbody tr:nth-child(2) td:last-child div",
+                "lines => lines.map(l => [l.textContent, l.title])")
+            assert reasons == [["avoid: touched", "touched"],
+                               ["goal: rules: called /gazebo/set_model_state for m2wr at "
+                                "(2.00\u2026", "rules: called /gazebo/set_model_state "
+                                "for m2wr at (2.00, 8.00), by /g, at 0.00 s"]]
+            assert "Turning: legacy_mode false" in page.inner_text("body")
+            page.set_viewport_size({"width": 1280, "height": 800})
+            page.screenshot(path=str(tmp_path / "class_table.png"))
             page.click("text=cat")
             page.wait_for_load_state("load")
             assert page.url.endswith("students/cat.html")
@@ -91,3 +111,4 @@ def test_the_class_table_sorts_and_a_students_page_shows_its_runs(site, tmp_path
             browser.close()
     assert errors == []
     assert (tmp_path / "student_page.png").stat().st_size > 1000
+    assert (tmp_path / "class_table.png").stat().st_size > 1000
