@@ -116,3 +116,17 @@ def test_wait_returns_as_soon_as_the_report_comes():
     own.written[("/scan", "/ctl", 5)] = 2
     assert board.wait({"/ctl"}, time.monotonic() + 0.1) == \
         ("/ctl", "/scan not taken in: 1 of 2")
+
+
+def test_a_tick_that_wakes_no_sleeper_is_not_waited_for():
+    board, own = make()
+    own.written[("/clock", "/ctl", 5)] = 4
+    board.take("/ctl", 1, 1, taken={("/clock", SIM, 5): 3}, written={}, next_wake=0)
+    board.sent_clock({"/ctl"}, 2000)
+    assert board.busy({"/ctl"}) is None          # no thread sleeps on sim time
+    board.take("/ctl", 1, 2, taken={("/clock", SIM, 5): 3}, written={}, next_wake=2050)
+    assert board.busy({"/ctl"}) is None          # its loop sleeps until 2050: not yet
+    board.sent_clock({"/ctl"}, 2050)
+    assert board.busy({"/ctl"}) == ("/ctl", "/clock not taken in: 3 of 4")   # its tick
+    board.take("/ctl", 1, 3, taken={("/clock", SIM, 5): 4}, written={}, next_wake=2100)
+    assert board.busy({"/ctl"}) is None

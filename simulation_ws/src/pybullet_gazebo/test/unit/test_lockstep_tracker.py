@@ -157,3 +157,17 @@ def test_nothing_is_sent_while_the_simulator_does_not_listen():
     tracker.call_ended(1)
     assert reports == [] and tracker.done()
     assert tracker.report_now()["called"] == []     # nothing kept for no one
+
+
+def test_a_report_names_the_earliest_wake_up_of_its_sleepers():
+    tracker, reports = make()
+    tracker.sleep_started(tid=7, start=1000 * MS, duration=50 * MS)
+    tracker.sleep_started(tid=8, start=1000 * MS, duration=20 * MS)
+    tracker.callback_started()
+    tracker.callback_ended(*SCAN, count=1)
+    assert reports[-1]["next_wake"] == 1020 * MS
+    tracker.sleep_ended(7)
+    tracker.sleep_ended(8)
+    tracker.callback_started()
+    tracker.callback_ended(*SCAN, count=1)
+    assert reports[-1]["next_wake"] == 0          # nobody sleeps on sim time

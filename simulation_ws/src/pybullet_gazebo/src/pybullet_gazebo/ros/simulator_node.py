@@ -350,7 +350,9 @@ class SimulatorNode:
         if sent:
             self.lockstep.sending()
             self.lockstep.stats.ticks += 1
-            self.clock_pub.publish_to_loop_nodes(self._loop_clock, {self._owed.pop(0)})
+            node = self._owed.pop(0)
+            self.board.sent_clock((node,), self._loop_clock.to_nsec())
+            self.clock_pub.publish_to_loop_nodes(self._loop_clock, {node})
         if not self._owed:
             self._loop_clock = self._owed = None
         return sent
@@ -399,7 +401,7 @@ class SimulatorNode:
             {(t, p, port): n for t, p, port, n in zip(msg.out_topics, msg.out_peers,
                                                        msg.out_ports, msg.out_counts)},
             served=list(zip(msg.served_services, msg.served_ports)),
-            called=list(zip(msg.called_services, msg.called_ports)))
+            called=list(zip(msg.called_services, msg.called_ports)), next_wake=msg.next_wake)
 
     def _note_busy_loop(self, pid, tid):
         """Lockstep took thread `tid` of `pid` for a busy loop: it is not waited for."""

@@ -19,6 +19,7 @@ import collections
 import threading
 import time
 
+CLOCK = "/clock"
 KEEP_CALLS = 4096          # unmatched service-call records kept (a client or server that died)
 
 
@@ -29,11 +30,14 @@ class NodeReport:
         self.reports = 0
         self.taken = {}              # (topic, publisher, port) -> count
         self.written = {}            # (topic, subscriber, port) -> count
+        self.next_wake = 0           # [ns sim] its earliest sleeper's wake-up, 0: none
 
-    def merge(self, pid, seq, taken, written):
+    def merge(self, pid, seq, taken, written, next_wake=0):
         """Totals only grow: a report older than one already merged changes nothing."""
         if pid != self.pid:          # a new process under the node's name: start over
             self.pid, self.seq, self.taken, self.written = pid, 0, {}, {}
+        if seq >= self.seq:
+            self.next_wake = next_wake
         self.seq = max(self.seq, seq)
         self.reports += 1
         for key, count in taken.items():
@@ -58,12 +62,14 @@ class Board:
         self._changed = threading.Condition()
         self._version = 0            # counts changes, so that a wait misses none
         self.silent = set()          # nodes stepped past at a time-out, until they report
+        self.clock_sent = {}         # node -> [ns sim] the last /clock tick sent to it
 
     # --- what comes in ----------------------------------------------------------------------
-    def take(self, node, pid, seq, taken, written, served=(), called=()):
+    def take(self, node, pid, seq, taken, written, served=(), called=(), next_wake=0):
         """A report from `node` (its connection's callerid, never a field of the report)."""
         with self._changed:
-            self._reports.setdefault(node, NodeReport()).merge(pid, seq, taken, written)
+            self._reports.setdefault(node, NodeReport()).merge(pid, seq, taken, written,
+                                                               next_wake)
             for key in served:
                 if self._called.pop(key, None) is None:
                     self._remember(self._served, key, node)
@@ -79,6 +85,12 @@ class Board:
         records[key] = node
         while len(records) > KEEP_CALLS:
             records.popitem(last=False)
+
+    def sent_clock(self, nodes, stamp_ns):
+        """The simulator sent `nodes` the /clock tick of `stamp_ns` [ns sim]."""
+        with self._changed:
+            for node in nodes:
+                self.clock_sent[node] = stamp_ns
 
     def notify(self):
         """The simulator's own counts changed (it read a command)."""
@@ -109,8 +121,13 @@ class Board:
                 report = reports.get(node)
                 if report is None:
                     return node, "no report yet"
+                # a tick that reaches no sleeper's wake-up wakes nothing: rospy only takes
+                # its time (the next one that does is waited for, with every tick before it)
+                skip_clock = report.next_wake == 0 or \
+                    report.next_wake > self.clock_sent.get(node, 0)
                 for (topic, peer, port), count in written_own.items():
-                    if peer == node and report.taken.get((topic, me, port), 0) < count:
+                    if peer == node and report.taken.get((topic, me, port), 0) < count \
+                            and not (skip_clock and topic == CLOCK):
                         return node, "%s not taken in: %d of %d" % (
                             topic, report.taken.get((topic, me, port), 0), count)
                 for (topic, peer, port), count in report.written.items():

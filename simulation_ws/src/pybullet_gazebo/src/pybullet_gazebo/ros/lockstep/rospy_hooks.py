@@ -270,7 +270,7 @@ def _reporting():
 
 def _message(report):
     from lockstep_msgs.msg import LockstepReport
-    msg = LockstepReport(pid=os.getpid(), seq=report["seq"])
+    msg = LockstepReport(pid=os.getpid(), seq=report["seq"], next_wake=report["next_wake"])
     for key, count in report["taken"].items():
         msg.in_topics.append(key[0])
         msg.in_peers.append(key[1])

@@ -235,8 +235,11 @@ class Tracker:
         taken = self._taken()
         served, self._served = self._served, []
         called, self._called = self._called, []
+        wakes = [wake for _, wake, _ in self._sleeping.values() if wake is not None]
+        if any(wake is None for _, wake, _ in self._sleeping.values()):
+            wakes.append(1)             # waits for the first /clock: any tick wakes it
         return {"seq": self.seq, "taken": taken, "written": dict(self.written),
-                "served": served, "called": called}
+                "served": served, "called": called, "next_wake": min(wakes, default=0)}
 
     def report_now(self):
         """A report of the counts as they are (for a simulator that just connected)."""
