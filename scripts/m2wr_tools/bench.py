@@ -388,6 +388,9 @@ def main(argv=None):
         os.environ.update(ROS_MASTER_URI=session.master_uri, ROS_HOSTNAME="localhost")
         import rospy
         rospy.init_node("m2wr_bench", disable_signals=True)
+        # it records and measures: lockstep need not wait for it (docs/lockstep.md)
+        from pybullet_gazebo.ros.lockstep import rospy_hooks
+        rospy_hooks.watch_only()
         listener = Listener()
         if args.web_only:
             from .bench_web import web_rounds

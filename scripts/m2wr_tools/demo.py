@@ -112,6 +112,9 @@ def run(args, session, paths):
     os.environ.pop("ROS_IP", None)
     say("master %s (logs in %s)" % (uri, session.log_dir))
     rospy.init_node("m2wr_demo", disable_signals=True)
+    # it records and measures: lockstep need not wait for it (docs/lockstep.md)
+    from pybullet_gazebo.ros.lockstep import rospy_hooks
+    rospy_hooks.watch_only()
     recorder = Recorder()
 
     say("simulator: %s, %s" % (args.world, "real time" if realtime

@@ -97,6 +97,7 @@ class Lockstep:
         self.reporting = set()               # controllers that report (the board asks them)
         self.watching = False                # the watch has processes to look at
         self._sent = False                   # something went to the controllers since settle
+        self._busy_at = None                 # the board's version when last found busy
 
     def wait_for(self, reporting, watched):
         """From now on: the controllers `reporting` by their reports, and `watched` (names)
@@ -111,6 +112,7 @@ class Lockstep:
         them to be done with it."""
         if self.enabled:
             self._sent = True
+            self._busy_at = None
             if self.watching:
                 self.watch.note_sent()
 
@@ -128,8 +130,13 @@ class Lockstep:
         the loop's steps between two looks."""
         if not self._sent:
             return True
-        if self.reporting and self.board.busy(self.reporting) is not None:
-            return False
+        if self.reporting:
+            version = self.board.version
+            if version == self._busy_at:         # nothing came since it was found busy
+                return False
+            if self.board.busy(self.reporting) is not None:
+                self._busy_at = version
+                return False
         if self.watching and not self.watch.idle_now():
             return False
         self.stats.settles += 1

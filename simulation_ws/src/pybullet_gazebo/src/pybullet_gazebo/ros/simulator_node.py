@@ -401,7 +401,8 @@ class SimulatorNode:
             {(t, p, port): n for t, p, port, n in zip(msg.out_topics, msg.out_peers,
                                                        msg.out_ports, msg.out_counts)},
             served=list(zip(msg.served_services, msg.served_ports)),
-            called=list(zip(msg.called_services, msg.called_ports)), next_wake=msg.next_wake)
+            called=list(zip(msg.called_services, msg.called_ports)), next_wake=msg.next_wake,
+            watcher=msg.watcher)
 
     def _note_busy_loop(self, pid, tid):
         """Lockstep took thread `tid` of `pid` for a busy loop: it is not waited for."""

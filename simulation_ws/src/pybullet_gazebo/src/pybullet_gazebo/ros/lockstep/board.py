@@ -31,13 +31,15 @@ class NodeReport:
         self.taken = {}              # (topic, publisher, port) -> count
         self.written = {}            # (topic, subscriber, port) -> count
         self.next_wake = 0           # [ns sim] its earliest sleeper's wake-up, 0: none
+        self.watcher = False         # it said it only watches: never waited for
 
-    def merge(self, pid, seq, taken, written, next_wake=0):
+    def merge(self, pid, seq, taken, written, next_wake=0, watcher=False):
         """Totals only grow: a report older than one already merged changes nothing."""
         if pid != self.pid:          # a new process under the node's name: start over
             self.pid, self.seq, self.taken, self.written = pid, 0, {}, {}
         if seq >= self.seq:
             self.next_wake = next_wake
+        self.watcher = self.watcher or watcher
         self.seq = max(self.seq, seq)
         self.reports += 1
         for key, count in taken.items():
@@ -65,11 +67,12 @@ class Board:
         self.clock_sent = {}         # node -> [ns sim] the last /clock tick sent to it
 
     # --- what comes in ----------------------------------------------------------------------
-    def take(self, node, pid, seq, taken, written, served=(), called=(), next_wake=0):
+    def take(self, node, pid, seq, taken, written, served=(), called=(), next_wake=0,
+             watcher=False):
         """A report from `node` (its connection's callerid, never a field of the report)."""
         with self._changed:
             self._reports.setdefault(node, NodeReport()).merge(pid, seq, taken, written,
-                                                               next_wake)
+                                                               next_wake, watcher)
             for key in served:
                 if self._called.pop(key, None) is None:
                     self._remember(self._served, key, node)
@@ -104,6 +107,16 @@ class Board:
             self._reports.pop(node, None)
             self.silent.discard(node)
 
+    def watchers(self):
+        """The nodes that said they only watch."""
+        with self._changed:
+            return {node for node, report in self._reports.items() if report.watcher}
+
+    @property
+    def version(self):
+        """Grows with every report taken and every change of the simulator's own counts."""
+        return self._version
+
     def report_of(self, node):
         return self._reports.get(node)
 
@@ -121,6 +134,8 @@ class Board:
                 report = reports.get(node)
                 if report is None:
                     return node, "no report yet"
+                if report.watcher:
+                    continue
                 # a tick that reaches no sleeper's wake-up wakes nothing: rospy only takes
                 # its time (the next one that does is waited for, with every tick before it)
                 skip_clock = report.next_wake == 0 or \

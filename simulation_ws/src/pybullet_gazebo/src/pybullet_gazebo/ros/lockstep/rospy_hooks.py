@@ -219,6 +219,18 @@ def install(report=True):
     return tracker
 
 
+def watch_only():
+    """This process only watches (records, measures): lockstep need not wait for it, as for a
+    display. Call after rospy.init_node; without the hooks it does nothing."""
+    if TRACKER is None or TRACKER.watcher:
+        return
+    TRACKER.watcher = True
+    if _reporting():
+        report = TRACKER.report_now()
+        if report is not None:
+            _send(report)
+
+
 def _local_port(connection):
     port = getattr(connection, "_lockstep_port", None)
     if port is None:
@@ -270,7 +282,8 @@ def _reporting():
 
 def _message(report):
     from lockstep_msgs.msg import LockstepReport
-    msg = LockstepReport(pid=os.getpid(), seq=report["seq"], next_wake=report["next_wake"])
+    msg = LockstepReport(pid=os.getpid(), seq=report["seq"], next_wake=report["next_wake"],
+                         watcher=report["watcher"])
     for key, count in report["taken"].items():
         msg.in_topics.append(key[0])
         msg.in_peers.append(key[1])

@@ -50,11 +50,15 @@ class Tracker:
         self._served = []                 # [(service, port)] answered since the last report
         self._called = []                 # [(service, port)] made since the last report
         self._news = False                # something to report once done
+        self._sent_taken = {}             # the counts as last reported
+        self._sent_written = {}
         self.seq = 0
         self.on_change = None             # called (no lock held) when `taken` grows
         # the simulator's own process counts what it takes in and writes, nothing more: its
         # loop polls rospy.is_shutdown() and must not be taken for a busy loop
         self.counting_only = False
+        # a process that only watches says so (rospy_hooks.watch_only) and reports no more
+        self.watcher = False
 
     # --- what the hooks say ------------------------------------------------------------
     def callback_started(self):
@@ -220,7 +224,7 @@ class Tracker:
             self._changed.notify_all()          # is a second one in a row: done again)
 
     def _after_change(self):
-        if self.counting_only:
+        if self.counting_only or self.watcher:
             return
         report = None
         with self._lock:
@@ -229,22 +233,30 @@ class Tracker:
         if report is not None:
             self.send(report)
 
-    def _report(self):
+    def _report(self, whole=False):
+        """The report: the connections whose counts changed since the last one (all with
+        `whole`): totals, so the simulator keeps the others as they were."""
         self._news = False
         self.seq += 1
-        taken = self._taken()
+        taken, written = self._taken(), dict(self.written)
+        if not whole:
+            taken = {k: n for k, n in taken.items() if self._sent_taken.get(k) != n}
+            written = {k: n for k, n in written.items() if self._sent_written.get(k) != n}
+        self._sent_taken.update(taken)
+        self._sent_written.update(written)
         served, self._served = self._served, []
         called, self._called = self._called, []
         wakes = [wake for _, wake, _ in self._sleeping.values() if wake is not None]
         if any(wake is None for _, wake, _ in self._sleeping.values()):
             wakes.append(1)             # waits for the first /clock: any tick wakes it
-        return {"seq": self.seq, "taken": taken, "written": dict(self.written),
-                "served": served, "called": called, "next_wake": min(wakes, default=0)}
+        return {"seq": self.seq, "taken": taken, "written": written,
+                "served": served, "called": called, "next_wake": min(wakes, default=0),
+                "watcher": self.watcher}
 
     def report_now(self):
         """A report of the counts as they are (for a simulator that just connected)."""
         with self._lock:
-            if not self._done():
+            if not (self._done() or self.watcher):
                 self._news = True
                 return None
-            return self._report()
+            return self._report(whole=True)
