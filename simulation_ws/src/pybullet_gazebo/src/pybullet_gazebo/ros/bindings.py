@@ -82,6 +82,12 @@ class Binding:
         only shows it; see clock_topic.py."""
         return {node for node, _ in self.loop_connections()}
 
+    def impl(self) -> list:
+        """The rospy topic implementations of the loop nodes' connections (their lists of
+        connections are replaced whenever one comes or goes)."""
+        return [s.impl for s in self.subscribers] + \
+            [p.publisher.impl for p in self.loop_publishers]
+
     def loop_connections(self) -> list:
         """[(node name, rospy connection)] of the loop nodes' connections to this part."""
         pairs = [(c.callerid_pub, c) for s in self.subscribers if s.impl is not None

@@ -362,13 +362,16 @@ class SimulatorNode:
         handshake), by the /proc watch of their processes otherwise. Both are asked again
         whenever the loop nodes' connections change (a node restarted under the same name,
         the batch runner's next controller, is a new process) or a node starts reporting."""
-        connections = [pair for b in list(self._bindings.values())
-                       for pair in b.loop_connections()]
-        reporters = self._reporters()
-        key = (frozenset(connection for _, connection in connections), reporters)
+        # rospy replaces a topic's list of connections whenever one comes or goes: the
+        # lists themselves (compared item by item, kept alive by the key) tell whether
+        # anything changed, without asking every binding for its pairs
+        key = self._connection_lists()
         if key == self._watched_key:
             return
         self._watched_key = key
+        connections = [pair for b in list(self._bindings.values())
+                       for pair in b.loop_connections()]
+        reporters = self._reporters()
         self._watched_names = names = {node for node, _ in connections}
         reporting = names & reporters
         watched = names - reporting
@@ -380,6 +383,14 @@ class SimulatorNode:
              % (n, self._node_processes.pid_of(n)) for n in sorted(watched)])
             or "no controller", "; and %s (pid %s), which their service calls go through" % (
                 MASTER, self._node_processes.pid_of(MASTER)) if watched else "")
+
+    def _connection_lists(self):
+        impls = [b.impl() for bindings in list(self._bindings.values())
+                 for b in bindings.by_part.values()]
+        impls.append(self._report_sub.impl if self._report_sub is not None else None)
+        return tuple(impl.connections if impl is not None else None
+                     for group in impls for impl in (group if isinstance(group, list)
+                                                     else [group]))
 
     def _reporters(self):
         """The nodes whose lockstep reports reach the simulator now."""

@@ -71,10 +71,11 @@ class Tracker:
         with self._lock:
             key = (topic, peer, port)
             self.taken[key] = self.taken.get(key, 0) + count
-            if now is not None:
-                self._wake_sleepers(now)
+            # a /clock tick that wakes no sleeper is no news: the simulator does not wait
+            # for such a tick (board.py), so it needs no report of it
+            news = now is None or self._wake_sleepers(now)
             self._running -= 1
-            self._wake_pollers()
+            self._wake_pollers(news)
         self._after_change()
         if self.on_change is not None:
             self.on_change()
@@ -209,16 +210,20 @@ class Tracker:
         return not (self._running or self._calls or self._due or self.pending_writes())
 
     def _wake_sleepers(self, now):
+        """Marks due the sleepers whose time has come; True if there were any."""
+        woke = False
         for tid, (start, wake, duration) in list(self._sleeping.items()):
             if wake is None:
                 if now:
                     self._sleeping[tid] = (now, now + duration, duration)
             elif now >= wake or now < start:
                 self._due.add(tid)
+                woke = True
+        return woke
 
-    def _wake_pollers(self):
+    def _wake_pollers(self, news=True):
         """Something happened: a held poller must look again before the process is done."""
-        self._news = True
+        self._news = self._news or news
         if self._held:
             self._due.update(self._held)        # (its next poll, if it finds nothing to do,
             self._changed.notify_all()          # is a second one in a row: done again)
