@@ -199,58 +199,10 @@ def test_work_handed_on_between_threads_and_processes_is_waited_for_to_the_end()
         relay.stdout.close()
 
 
-def test_idle_now_never_finds_a_busy_child_idle_and_never_waits(child):
-    """The loop's look between two physics steps (lockstep hands a /clock tick on when it
-    says idle): while the child computes it answers False at once, whatever the machine
-    runs; once the child sleeps in its read, a quiet machine lets it answer True."""
-    worker = child(WORKER, "0.03")                 # (well under SPIN_WALL: no busy loop,
-                                                   # even on a loaded machine)
-    watch = IdleWatch()
-    watch.watch([worker.pid])
-    assert settle(watch) is None
-    watch.note_sent()
-    worker.stdin.write("1\n")
-    worker.stdin.flush()
-    time.sleep(0.005)                              # it computes for 0.03 s of CPU now
-    start = time.monotonic()
-    for _ in range(20):
-        assert not watch.idle_now()
-    assert time.monotonic() - start < 0.05         # looks, not waits
-    assert settle(watch) is None and answered(worker) == ["done 1"]
-    deadline = time.monotonic() + 5.0              # other jobs may keep the machine busy
-    while not watch.idle_now() and time.monotonic() < deadline:
-        time.sleep(0.01)
-    assert watch.busy() is None
-
-
-def test_the_run_queue_counts_a_running_child(child):
-    from pybullet_gazebo.ros.idle_threads import RunQueue
-    queue = RunQueue()
-    assert queue.runnable() >= 1                   # this thread, reading it
-    spinner = child(SPIN_THEN_SLEEP, "30")
-    assert all(queue.runnable() >= 2 for _ in range(100)), spinner.pid
-    queue.close()
-
-
 @pytest.mark.parametrize("columns, backlog", [(15, (13, 14)), (13, (11,)), (11, ())])
 def test_the_kernel_backlog_columns_follow_the_kernel(columns, backlog):
     from pybullet_gazebo.ros.idle_threads import _backlog_columns
     assert _backlog_columns(columns) == backlog
-
-
-def test_the_quick_look_reads_threads_it_has_not_seen_before(child):
-    """The quick look's check of the thread states must read every thread, also on a watch
-    that has not looked at the process before (it once read only known threads: none)."""
-    from pybullet_gazebo.ros.idle_threads import ProcessThreads
-    worker = child(WORKER, "0.5")
-    worker.stdin.write("1\n")
-    worker.stdin.flush()
-    time.sleep(0.05)                               # it computes for 0.5 s now
-    threads = ProcessThreads(worker.pid)
-    try:
-        assert threads.asleep_now() is not None
-    finally:
-        threads.close()
 
 
 def _timer_slack():

@@ -100,22 +100,31 @@ def test_disabled_or_forgotten_lockstep_never_waits():
     assert lock.settle() and time.monotonic() - start < 0.1 and told == []
 
 
-class QuickWatch(FakeWatch):
-    """A FakeWatch whose idle_now() answers as IdleWatch's: only a quick look, counted."""
+class Board:
+    """A lockstep/board.py stand-in: busy until `done_at` (monotonic)."""
 
-    def __init__(self, idle_at=0.0):
-        super().__init__(idle_at)
-        self.quick_looks = 0
+    def __init__(self, done_at):
+        self.done_at = done_at
+        self.version = 0
+        self.silent = set()
 
-    def idle_now(self):
-        self.quick_looks += 1
-        return self.busy() is None
+    def busy(self, nodes):
+        self.version += 1                 # as if a report came at every look
+        return None if time.monotonic() >= self.done_at else ("/ctl", "no report yet")
+
+    def wait(self, nodes, deadline, interrupted=lambda: False):
+        while self.busy(nodes) is not None:
+            if time.monotonic() >= deadline or interrupted():
+                return self.busy(nodes)
+            time.sleep(0.001)
+        return None
 
 
-def test_settled_now_never_waits_and_settles_once_idle():
-    watch = QuickWatch(idle_at=time.monotonic() + 0.2)
-    lock, told = make(watch, timeout=5.0)
-    assert lock.settled_now() and watch.quick_looks == 0       # nothing sent: no look
+def test_settled_now_never_waits_and_settles_once_the_reports_say_done():
+    board = Board(done_at=time.monotonic() + 0.2)
+    lock = Lockstep(True, 5.0, board, None, is_shutdown=lambda: False)
+    lock.wait_for(reporting={"/ctl"}, watched=())
+    assert lock.settled_now()                                   # nothing sent
     lock.sending()
     start = time.monotonic()
     assert not lock.settled_now() and time.monotonic() - start < 0.05
@@ -124,7 +133,25 @@ def test_settled_now_never_waits_and_settles_once_idle():
     assert lock.settled_now() and not lock.unsettled
     assert (lock.stats.settles, lock.stats.waits, lock.stats.wall_waiting) == (1, 0, 0.0)
     assert lock.settle() and lock.stats.settles == 1          # nothing left to wait for
-    assert told == []
+
+
+def test_a_controller_watched_in_proc_is_settled_only_by_a_wait():
+    lock, told = make(FakeWatch(idle_at=0.0), timeout=5.0)
+    lock.sending()
+    assert not lock.settled_now()                 # two looks: only settle() takes them
+    assert lock.settle() and told == []
+
+
+def test_a_timeout_on_a_report_names_why_and_skips_the_node_until_it_reports():
+    board = Board(done_at=float("inf"))
+    told = []
+    lock = Lockstep(True, 0.05, board, None, is_shutdown=lambda: False,
+                    on_timeout=told.append)
+    lock.wait_for(reporting={"/ctl"}, watched=())
+    lock.sending()
+    assert lock.settle()
+    assert told == ["node /ctl (no report yet)"] and board.silent == {"/ctl"}
+    assert "by handshake (exact): /ctl" in lock.stats.summary()
 
 
 def test_the_summary_counts_ticks_handed_on_while_stepping():

@@ -1,10 +1,9 @@
-"""Whether processes have finished with what they were sent: lockstep's barrier (pacing.py).
+"""Whether processes have finished with what they were sent, as Linux shows it: lockstep's
+fallback for the controllers that cannot say so themselves (pacing.py; a process of the
+project's environment reports instead, lockstep/).
 
-Lockstep must know when every controller has done with a message before the simulation goes
-on. A program that answers scans publishes a command, but a program on its own rospy.Rate
-loop may tick without publishing (a state change, a behaviour switched off), publish twice,
-or publish from another thread; waiting for "a command" cannot tell. So the simulator looks
-at the controllers' processes themselves, as the kernel sees them: a process is idle when
+A controller that sends no reports (roscpp, a Python outside the project's venv) is watched
+in its process, as the kernel sees it: a process is idle when
 none of its threads is running or waiting for a CPU (state R in /proc/PID/task/TID/stat) or
 in an uninterruptible wait (D). That holds on a loaded machine too: a thread that waits for a
 CPU is R.
@@ -32,18 +31,6 @@ slept with nothing handed on (a thread only falls asleep by running). Measured o
 nodes handing work on through service calls): without the second look, one run in two took a
 switch at a different tick.
 
-The quick look. Most of the time nothing on the machine but the simulator's own loop is
-runnable: the kernel's count of runnable tasks (/proc/loadavg's fourth field, summed over the
-CPUs at one moment) is then 1, its own thread. That one read (1.5 us) stands for both looks:
-at that moment no thread of any process was running or waiting for a CPU, and no packet was in
-the backlog just read, so nothing was being handed on. Only the simulator's own readers are
-still looked at (one asleep outside a socket wait may hold a message, waiting for the GIL that
-the simulator's loop holds). Not beside a known busy loop, whose process's sleeping threads
-may be waiting for its GIL (the whole looks handle those). When anything else runs (a
-controller at work, a busy loop, other jobs on a shared machine) the watch takes the two
-looks above. (A thread in an uninterruptible
-wait, D, is not counted as runnable: the quick look misses a controller blocked on its disk.)
-
 Busy loops. A thread that never sleeps (the series' go_to_point spins in
 `while not rospy.is_shutdown(): if not active_: continue` while switched off) is never idle.
 A thread seen running at every look for SPIN_WALL of wall time, having had at least
@@ -66,13 +53,11 @@ busy loop thus costs lockstep about one switch interval of wall time per message
 gets, as it delays that process's callbacks at real time.
 
 Polling. A wait looks again every POLL of wall time. Linux lets a thread's short sleeps run
-late by its timer slack (50 us by default, so the kernel can batch wake-ups): a sleep of
-100 us lasted 175 us on the development machine, one of 30 us 100 us. The waiting thread asks
-for a slack of 1 ns (precise_sleeps): 30 us then lasts about 55 us. A rospy.Rate loop's tick
-passes from thread to thread (its /clock reader wakes the loop, which publishes through
-rospy's writer thread), and every hand-off the wait sees late costs it a whole sleep: with
-the shorter sleeps the loop program ran 5 % faster, the tutorial's obstacle avoider and the
-simulator's CPU per sim second about the same (docs/performance.md, 27 Nov 11:00-11:40).
+late by its timer slack (50 us by default, so the kernel can batch wake-ups), which would
+make each short sleep several times as long; the waiting thread asks for a slack of 1 ns
+(precise_sleeps). A rospy.Rate loop's tick passes from thread to thread (its /clock reader
+wakes the loop, which publishes through rospy's writer thread), and every hand-off the wait
+sees late costs it a whole sleep.
 
 Linux only (/proc); threads of processes on other machines cannot be watched.
 """
@@ -191,14 +176,6 @@ class ProcessThreads:
         except (OSError, ValueError, IndexError):
             return False
 
-    def asleep_now(self):
-        """After the quick look (no busy loop known): a tid of a thread running or waiting
-        for a CPU (or being woken), None if all sleep, False when the process is gone."""
-        running = self._states(note_runs=False)
-        if running is None:
-            return False
-        return next((tid for tid, run in running.items() if run), None)
-
     def _states(self, note_runs):
         """{tid: running or waiting for a CPU} of every thread now, those new since the last
         look too (ended ones forgotten), or None when the process is gone. `note_runs`: keep
@@ -313,29 +290,6 @@ def _backlog_columns(columns):
     return ()
 
 
-class RunQueue:
-    """The number of runnable tasks on the machine now (running or waiting for a CPU)."""
-
-    def __init__(self):
-        self._fd = None
-        try:
-            self._fd = os.open("/proc/loadavg", os.O_RDONLY)
-            self.runnable()
-        except (OSError, ValueError, IndexError):
-            self.close()
-
-    def runnable(self):
-        """The count, or None where /proc/loadavg cannot tell."""
-        if self._fd is None:
-            return None
-        return int(os.pread(self._fd, 128, 0).split()[3].split(b"/")[0])
-
-    def close(self):
-        if self._fd is not None:
-            os.close(self._fd)
-        self._fd = None
-
-
 class KernelBacklog:
     """Packets in the CPUs' input backlogs, not yet delivered to any socket."""
 
@@ -373,7 +327,6 @@ class IdleWatch:
         self.own_moved = own_moved          # ... and its second look (OwnReceivers.moved)
         self.on_spin = on_spin              # told (pid, tid) of a thread taken for a busy loop
         self.backlog = KernelBacklog()
-        self.run_queue = RunQueue()
         self._processes = {}                # pid -> ProcessThreads
         self._round_start = 0.0             # [s] monotonic: when the present wait began
         self._precise_thread = None         # the thread whose sleeps precise_sleeps shortened
@@ -398,9 +351,8 @@ class IdleWatch:
 
     def busy(self, new_round=True):
         """(pid, tid) of a thread still at work, ("self", None) for the simulator's own
-        receivers, ("kernel", n) for n packets not yet delivered, ("machine", None) when a
-        quick look was undone by another task, or None when all are idle. Processes that
-        ended are dropped.
+        receivers, ("kernel", n) for n packets not yet delivered, or None when all are idle.
+        Processes that ended are dropped.
         `new_round`: this look starts a wait (see the module docstring on busy loops)."""
         now = time.monotonic()
         if new_round:
@@ -408,28 +360,12 @@ class IdleWatch:
         packets = self.backlog.packets()
         if packets:
             return "kernel", packets
-        if self._quick_look_holds():
-            return self._confirm_quick_look()
         busy = self._first_busy(lambda p: p.busy_thread(now, self._round_start))
         if busy is not None:
             return busy
         if self.own_busy():
             return "self", None
         return self._second_look()
-
-    def idle_now(self):
-        """True when every watched process is idle now, by a quick look only: False, without
-        a look at the threads, when the machine runs anything but the caller (a whole look
-        costs as much as the stretch of physics a caller would fit it between)."""
-        if not self._quick_look_holds() or self.backlog.packets():
-            return False
-        self._round_start = time.monotonic()
-        return self._confirm_quick_look() is None
-
-    def _quick_look_holds(self):
-        """Whether the quick look may stand for both looks (see the module docstring): the
-        machine runs nothing but the caller, and no busy loop is known."""
-        return self.run_queue.runnable() == 1 and not self._spinning()
 
     def _first_busy(self, look):
         """(pid, tid) of the first process in which `look(process)` finds a thread at work,
@@ -440,21 +376,6 @@ class IdleWatch:
                 self._processes.pop(pid).close()
             elif tid is not None:
                 return pid, tid
-        return None
-
-    def _spinning(self):
-        """Whether a busy loop is known (its process's sleeping threads may be waiting for
-        the GIL: only the whole looks can tell, see _done_beside_spinner)."""
-        return any(t.spinning for p in self._processes.values() for t in p.threads.values())
-
-    def _confirm_quick_look(self):
-        busy = self._first_busy(ProcessThreads.asleep_now)
-        if busy is not None:
-            return busy
-        if self.own_busy():
-            return "self", None
-        if self.run_queue.runnable() != 1:
-            return "machine", None
         return None
 
     def _second_look(self):
@@ -504,4 +425,3 @@ class IdleWatch:
     def close(self):
         self.watch(())
         self.backlog.close()
-        self.run_queue.close()
