@@ -1,7 +1,8 @@
 """Lockstep with misbehaving controllers (issue 26, bad input): beside obstacle_avoidance.py
 driving m2wr, robot b's controllers publish 1000 times a wall second, answer every odometry
-message twice, read m2wr's scans and never answer, or spin in a busy loop while switched off
-(taken for a busy loop and not waited for). Lockstep is not stalled by them, m2wr's
+message twice, read m2wr's scans and never answer, spin in a busy loop while switched off,
+stop answering for 3 s, die in the middle of a callback, or send lockstep reports of their own
+making. Lockstep is not stalled by them, m2wr's
 trajectory is the same to the last bit as without them, and the run summary says what each
 sent and how long lockstep waited for whom. (scripts/test/fixtures/neighbours_run.py does
 one run in a subprocess: its own master, everything stopped by PID at its end.)"""
@@ -27,7 +28,8 @@ def neighbours_run(log_dir, *modes):
 
 def test_misbehaving_neighbours_do_not_change_m2wr_s_run(tmp_path):
     alone = neighbours_run(tmp_path / "alone")
-    beside = neighbours_run(tmp_path / "beside", "spam", "twice", "never", "spin")
+    beside = neighbours_run(tmp_path / "beside", "spam", "twice", "never", "spin", "stall",
+                            "die", "fake")
     assert alone["sim_s"] == beside["sim_s"] >= SECONDS - 0.05
     assert alone["odom_messages"] == beside["odom_messages"]
     assert alone["m2wr"] == beside["m2wr"]            # the same pose, to the last bit
@@ -49,8 +51,12 @@ def test_misbehaving_neighbours_do_not_change_m2wr_s_run(tmp_path):
                  "/reading_laser"):
         assert node in lockstep.split("by handshake (exact): ")[1], lockstep
     assert "watched in /proc" not in lockstep, lockstep
-    # the flood is waited for only as long as lockstep_timeout allows, and named
-    assert "0 time-outs" in lockstep or "still at work: node /bad_neighbour_spam" in lockstep
+    # the stalled one is stepped past after lockstep_timeout, named with what it had not
+    # taken in; the flood is waited for only as long as lockstep_timeout allows, and named
+    assert "still at work: node /bad_neighbour_stall (/m2wr/laser/scan not taken in" \
+        in lockstep, lockstep
+    assert "/bad_neighbour_spam" not in lockstep.split("still at work")[-1] or \
+        "node /bad_neighbour_spam (/b/cmd_vel not read" in lockstep
 
 
 def per_node(result, heading):
