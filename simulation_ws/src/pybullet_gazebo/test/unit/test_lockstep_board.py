@@ -19,9 +19,10 @@ class Own:
         return dict(self.taken), dict(self.written)
 
 
-def make(providers=None):
+def make(providers=None, inbound=None):
     own = Own()
-    board = Board(SIM, own, service_provider=(providers or {}).get)
+    board = Board(SIM, own, service_provider=(providers or {}).get,
+                  own_inbound=(lambda: inbound) if inbound is not None else None)
     return board, own
 
 
@@ -36,7 +37,7 @@ def test_busy_until_the_report_counts_every_message_sent():
 
 
 def test_busy_until_the_simulator_has_read_every_command_reported():
-    board, own = make()
+    board, own = make(inbound={("/cmd_vel", "/ctl", 6)})
     board.take("/ctl", 1, 1, taken={}, written={("/cmd_vel", SIM, 6): 4})
     own.taken[("/cmd_vel", "/ctl", 6)] = 3
     assert "not read by the simulator" in board.busy({"/ctl"})[1]
@@ -77,7 +78,8 @@ def test_a_service_call_waits_for_its_server_in_either_order():
     nodes = {"/bug2", "/go_to_point"}
     board.take("/go_to_point", 1, 1, taken={}, written={})
     board.take("/bug2", 2, 1, taken={}, written={}, called=[("/go_to_point_switch", 9)])
-    assert board.busy(nodes) == ("/go_to_point", "/go_to_point_switch called by /bug2")
+    assert board.busy(nodes) == ("/bug2", "its call to /go_to_point_switch not yet answered "
+                                           "by /go_to_point")
     board.take("/go_to_point", 1, 2, taken={}, written={},
                served=[("/go_to_point_switch", 9)])
     assert board.busy(nodes) is None
@@ -95,14 +97,26 @@ def test_a_call_to_a_server_that_does_not_report_ended_with_its_answer():
     assert board.busy({"/ctl"}) is None
 
 
-def test_a_node_stepped_past_is_skipped_until_it_reports_again():
+def test_a_node_stepped_past_is_skipped_until_its_reports_add_up_again():
     board, own = make()
     own.written[("/scan", "/ctl", 5)] = 1
     board.take("/ctl", 1, 1, taken={}, written={})
     board.silent.add("/ctl")
     assert board.busy({"/ctl"}) is None
-    board.take("/ctl", 1, 2, taken={}, written={})
-    assert board.busy({"/ctl"}) is not None
+    board.take("/ctl", 1, 2, taken={}, written={})           # still behind: still skipped
+    assert board.busy({"/ctl"}) is None and "/ctl" in board.silent
+    board.take("/ctl", 1, 3, taken={("/scan", SIM, 5): 1}, written={})
+    assert board.busy({"/ctl"}) is None and "/ctl" not in board.silent
+    own.written[("/scan", "/ctl", 5)] = 2
+    assert board.busy({"/ctl"}) is not None                  # waited for again
+
+
+def test_a_report_cannot_make_the_simulator_wait_for_what_no_connection_brings():
+    board, own = make(inbound={("/cmd_vel", "/ctl", 6)})
+    board.take("/fake", 1, 1, taken={}, written={("/cmd_vel", SIM, 1): 10 ** 9})
+    board.take("/ctl", 2, 1, taken={}, written={("/cmd_vel", SIM, 6): 1})
+    own.taken[("/cmd_vel", "/ctl", 6)] = 1
+    assert board.busy({"/fake", "/ctl"}) is None
 
 
 def test_wait_returns_as_soon_as_the_report_comes():

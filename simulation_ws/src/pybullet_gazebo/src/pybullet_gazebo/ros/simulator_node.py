@@ -90,7 +90,8 @@ class SimulatorNode:
             # the handshake: the simulator's own counts (never reported) against each
             # controller's reports (lockstep/)
             own = rospy_hooks.install(report=False)
-            self.board = Board(rospy.get_name(), own.counts, ServiceProviders(rospy.get_name()))
+            self.board = Board(rospy.get_name(), own.counts, ServiceProviders(rospy.get_name()),
+                               own_inbound=rospy_hooks.inbound_connections)
             own.on_change = self.board.notify
             # no Nagle on the reports: a report held back for the last one's ACK would hold
             # the simulation for the receiver's delayed ACK

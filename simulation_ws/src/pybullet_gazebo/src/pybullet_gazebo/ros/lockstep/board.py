@@ -51,19 +51,22 @@ class NodeReport:
 
 
 class Board:
-    def __init__(self, own_name, own_counts, service_provider=lambda service: None):
+    def __init__(self, own_name, own_counts, service_provider=lambda service: None,
+                 own_inbound=None):
         """`own_name`: the simulator's node name; `own_counts()`: (taken, written) of the
         simulator's own connections, keyed as in a report; `service_provider(name)`: the
-        node that offers a service, or None."""
+        node that offers a service, or None; `own_inbound()`: the keys of the simulator's
+        subscriber connections now (default: those it has taken something from)."""
         self.own_name = own_name
         self.own_counts = own_counts
+        self.own_inbound = own_inbound or (lambda: set(own_counts()[0]))
         self.service_provider = service_provider
         self._reports = {}                             # node -> NodeReport
         self._called = collections.OrderedDict()       # (service, port) -> client node
         self._served = collections.OrderedDict()       # (service, port) -> server node
         self._changed = threading.Condition()
         self._version = 0            # counts changes, so that a wait misses none
-        self.silent = set()          # nodes stepped past at a time-out, until they report
+        self.silent = set()          # nodes stepped past at a time-out, until they add up
         self.clock_sent = {}         # node -> [ns sim] the last /clock tick sent to it
 
     # --- what comes in ----------------------------------------------------------------------
@@ -79,7 +82,6 @@ class Board:
             for key in called:
                 if self._served.pop(key, None) is None:
                     self._remember(self._called, key, node)
-            self.silent.discard(node)
             self._version += 1
             self._changed.notify_all()
 
@@ -123,43 +125,55 @@ class Board:
     # --- the question -----------------------------------------------------------------------
     def busy(self, nodes):
         """The first of `nodes` (reporting controllers) not yet done with what it was sent,
-        with why, as (node, why); None when all are done."""
+        with why, as (node, why); None when all are done. A node stepped past at a time-out
+        (`silent`) is skipped until its reports add up again."""
         taken_own, written_own = self.own_counts()
-        me = self.own_name
+        inbound = self.own_inbound()
         with self._changed:
-            reports = self._reports
             for node in nodes:
+                why = self._not_done(node, nodes, taken_own, written_own, inbound)
                 if node in self.silent:
+                    if why is None:
+                        self.silent.discard(node)     # it caught up: waited for again
                     continue
-                report = reports.get(node)
-                if report is None:
-                    return node, "no report yet"
-                if report.watcher:
-                    continue
-                # a tick that reaches no sleeper's wake-up wakes nothing: rospy only takes
-                # its time (the next one that does is waited for, with every tick before it)
-                skip_clock = report.next_wake == 0 or \
-                    report.next_wake > self.clock_sent.get(node, 0)
-                for (topic, peer, port), count in written_own.items():
-                    if peer == node and report.taken.get((topic, me, port), 0) < count \
-                            and not (skip_clock and topic == CLOCK):
-                        return node, "%s not taken in: %d of %d" % (
-                            topic, report.taken.get((topic, me, port), 0), count)
-                for (topic, peer, port), count in report.written.items():
-                    if peer == me:
-                        if taken_own.get((topic, node, port), 0) < count:
-                            return node, "%s not read by the simulator yet" % topic
-                    elif peer in nodes and peer not in self.silent:
-                        other = reports.get(peer)
-                        if other is not None and \
-                                other.taken.get((topic, node, port), 0) < count:
-                            return peer, "%s from %s not taken in" % (topic, node)
-            for (service, _), client in list(self._called.items()):
+                if why is not None:
+                    return why
+            for (service, port), client in list(self._called.items()):
                 server = self.service_provider(service)
-                if server is None or server not in reports or server in self.silent:
-                    self._called.pop((service, _), None)   # ended when its answer came
+                if server is None or server not in self._reports or server in self.silent \
+                        or client not in nodes or client in self.silent:
+                    self._called.pop((service, port), None)  # ended when its answer came
                     continue
-                return server, "%s called by %s" % (service, client)
+                return client, "its call to %s not yet answered by %s" % (service, server)
+        return None
+
+    def _not_done(self, node, nodes, taken_own, written_own, inbound):
+        """(node, why) if `node`'s report does not yet cover what it was sent, else None."""
+        me = self.own_name
+        report = self._reports.get(node)
+        if report is None:
+            return node, "no report yet"
+        if report.watcher:
+            return None
+        # a tick that reaches no sleeper's wake-up wakes nothing: rospy only takes its time
+        # (the next one that does is waited for, with every tick before it)
+        skip_clock = report.next_wake == 0 or report.next_wake > self.clock_sent.get(node, 0)
+        for (topic, peer, port), count in written_own.items():
+            if peer == node and report.taken.get((topic, me, port), 0) < count \
+                    and not (skip_clock and topic == CLOCK):
+                return node, "%s not taken in: %d of %d" % (
+                    topic, report.taken.get((topic, me, port), 0), count)
+        for (topic, peer, port), count in report.written.items():
+            if peer == me:
+                # only on a connection the simulator has: a report cannot make it wait
+                # for messages that no connection of its own will bring
+                if (topic, node, port) in inbound and \
+                        taken_own.get((topic, node, port), 0) < count:
+                    return node, "%s not read by the simulator yet" % topic
+            elif peer in nodes and peer not in self.silent:
+                other = self._reports.get(peer)
+                if other is not None and other.taken.get((topic, node, port), 0) < count:
+                    return peer, "%s from %s not taken in" % (topic, node)
         return None
 
     def wait(self, nodes, deadline, interrupted=lambda: False):

@@ -231,6 +231,19 @@ def watch_only():
             _send(report)
 
 
+def inbound_connections():
+    """{(topic, publisher, port)} of this process's subscriber connections now (keyed as the
+    Tracker counts them)."""
+    from rospy.impl.registration import get_topic_manager
+    keys = set()
+    for topic, impl in list(get_topic_manager().subs.items()):
+        if topic in NOT_COUNTED:
+            continue
+        for connection in list(impl.connections):
+            keys.add((topic, connection.callerid_pub, _local_port(connection)))
+    return keys
+
+
 def _local_port(connection):
     port = getattr(connection, "_lockstep_port", None)
     if port is None:
