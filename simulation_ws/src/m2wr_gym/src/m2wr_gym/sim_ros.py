@@ -97,6 +97,10 @@ class RosSim:
         self._lock = threading.Lock()
         self._odom = None
         self._contacts = []                     # (stamp, touching names) as published
+        # the agent thinks on wall time while physics is paused: lockstep watches this
+        # process in /proc rather than by its reports (docs/lockstep.md)
+        from pybullet_gazebo.ros.lockstep import rospy_hooks
+        rospy_hooks.proc_watch_instead()
         self._cmd = rospy.Publisher(COMMAND_TOPIC, Twist, queue_size=10)
         self._subs = [
             rospy.Subscriber(SCAN_TOPIC, LaserScan, self._scans.put, queue_size=100),

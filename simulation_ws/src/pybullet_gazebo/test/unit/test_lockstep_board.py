@@ -144,3 +144,21 @@ def test_a_tick_that_wakes_no_sleeper_is_not_waited_for():
     assert board.busy({"/ctl"}) == ("/ctl", "/clock not taken in: 3 of 4")   # its tick
     board.take("/ctl", 1, 3, taken={("/clock", SIM, 5): 4}, written={}, next_wake=2100)
     assert board.busy({"/ctl"}) is None
+
+
+def test_a_call_the_simulator_answered_waits_for_its_clients_word():
+    """The Gym environment publishes a command, then calls /gazebo/unpause_physics: the
+    simulator steps on only once the client's report says it got the answer, and so counts
+    the command written before."""
+    answered = [("/gazebo/unpause_physics", 7, "/env")]
+    own = Own()
+    board = Board(SIM, own, own_inbound=lambda: {("/cmd_vel", "/env", 6)},
+                  own_answered=lambda: [answered.pop()] if answered else [])
+    board.take("/env", 1, 1, taken={}, written={})
+    assert board.pending_calls({"/env"})
+    assert board.busy({"/env"})[0] == "/env"
+    board.take("/env", 1, 2, taken={}, written={("/cmd_vel", SIM, 6): 1},
+               called=[("/gazebo/unpause_physics", 7)])
+    assert board.busy({"/env"}) == ("/env", "/cmd_vel not read by the simulator yet")
+    own.taken[("/cmd_vel", "/env", 6)] = 1
+    assert board.busy({"/env"}) is None and not board.pending_calls({"/env"})

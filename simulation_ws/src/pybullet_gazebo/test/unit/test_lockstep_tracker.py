@@ -172,3 +172,28 @@ def test_a_report_names_the_earliest_wake_up_of_its_sleepers():
     tracker.callback_started()
     tracker.callback_ended(*SCAN, count=1)
     assert reports[-1]["next_wake"] == 0          # nobody sleeps on sim time
+
+
+def test_a_thread_handed_a_message_through_a_condition_is_waited_for():
+    """A callback that puts the scan in a queue the main loop reads is done with it only
+    once the main loop waits again (the Gym environment's pattern)."""
+    tracker, reports = make()
+    condition = object()                            # stands for a queue's condition
+    tracker.cond_wait_started(tid=1, condition=condition)        # main loop: queue.get()
+    tracker.callback_started()
+    tracker.cond_notified(condition, 1)                           # the callback's put()
+    tracker.cond_wait_ended(tid=1, condition=condition)
+    tracker.callback_ended(*SCAN, count=1)
+    assert not tracker.done() and reports == []                  # the main loop is at work
+    tracker.wrote("/cmd_vel", "/gazebo", 40000)
+    tracker.cond_wait_started(tid=1, condition=condition)        # back to queue.get()
+    assert tracker.done() and reports[-1]["written"] == {("/cmd_vel", "/gazebo", 40000): 1}
+
+
+def test_a_wait_that_times_out_leaves_its_thread_not_due():
+    tracker, _ = make()
+    condition = object()
+    tracker.cond_wait_started(tid=1, condition=condition)
+    tracker.cond_wait_ended(tid=1, condition=condition)          # timed out
+    tracker.cond_notified(condition, 1)                          # nobody waits now
+    assert tracker.done()

@@ -108,6 +108,9 @@ class Board:
         self.version = 0
         self.silent = set()
 
+    def pending_calls(self, nodes):
+        return False
+
     def busy(self, nodes):
         self.version += 1                 # as if a report came at every look
         return None if time.monotonic() >= self.done_at else ("/ctl", "no report yet")

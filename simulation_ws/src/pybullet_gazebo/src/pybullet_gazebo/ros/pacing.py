@@ -118,7 +118,9 @@ class Lockstep:
 
     @property
     def unsettled(self):
-        return self._sent
+        """Something went to the controllers, or the simulator answered a call of theirs,
+        since they were last found done."""
+        return self._sent or bool(self.reporting) and self.board.pending_calls(self.reporting)
 
     def forget(self):
         """A reset: nothing sent is waited for any more."""
@@ -128,7 +130,7 @@ class Lockstep:
         """Without waiting: True when the controllers are done with what they were sent (as
         settle() would find at once), False when someone may still be at work. Cheap: for
         the loop's steps between two looks."""
-        if not self._sent:
+        if not self.unsettled:
             return True
         if self.reporting:
             version = self.board.version
@@ -163,7 +165,7 @@ class Lockstep:
     def settle(self):
         """Waits until the controllers are done with what they were sent. False when physics
         was paused meanwhile (the wait is taken up again once it runs)."""
-        if not self._sent:
+        if not self.unsettled:
             return True
         self.stats.settles += 1
         busy = self._look()

@@ -91,7 +91,8 @@ class SimulatorNode:
             # controller's reports (lockstep/)
             own = rospy_hooks.install(report=False)
             self.board = Board(rospy.get_name(), own.counts, ServiceProviders(rospy.get_name()),
-                               own_inbound=rospy_hooks.inbound_connections)
+                               own_inbound=rospy_hooks.inbound_connections,
+                               own_answered=own.take_answered)
             own.on_change = self.board.notify
             # no Nagle on the reports: a report held back for the last one's ACK would hold
             # the simulation for the receiver's delayed ACK
@@ -328,9 +329,9 @@ class SimulatorNode:
         sends them the /clock tick they are still owed (that of the readings they just took
         in: after them, so that a rospy.Rate loop it wakes reads them), to one node at a
         time, waiting for each. False when physics was paused meanwhile."""
+        self._watch_loop_nodes()             # (who the controllers are may change while paused)
         if not (self.lockstep.unsettled or self._loop_clock is not None):
             return True
-        self._watch_loop_nodes()
         settled = self.lockstep.settle()
         if not settled:
             return False

@@ -9,7 +9,10 @@ counts reach the report's. Between two controllers that both report, the same ho
 topics, and for a service call: a call one reports made (named by the call's connection) is
 done with once its server has reported it answered, since the server may have changed its
 mind (bug 2 switching go to point on) and its loop must look again first. A call to a server
-that does not report (the simulator's own services, a roscpp node) ended when its answer came.
+that does not report (a roscpp node) ended when its answer came. A call to the simulator's own
+services (unpause, set_model_state, a state read) is done with once its client has reported
+it got the answer: whatever the client did meanwhile (a command published before the
+unpause) is in that report.
 
 All counts, so a report that comes late, twice or out of order never says too much: a
 controller is done exactly when its latest report is about everything, whatever the machine's
@@ -52,7 +55,7 @@ class NodeReport:
 
 class Board:
     def __init__(self, own_name, own_counts, service_provider=lambda service: None,
-                 own_inbound=None):
+                 own_inbound=None, own_answered=lambda: ()):
         """`own_name`: the simulator's node name; `own_counts()`: (taken, written) of the
         simulator's own connections, keyed as in a report; `service_provider(name)`: the
         node that offers a service, or None; `own_inbound()`: the keys of the simulator's
@@ -60,6 +63,8 @@ class Board:
         self.own_name = own_name
         self.own_counts = own_counts
         self.own_inbound = own_inbound or (lambda: set(own_counts()[0]))
+        self.own_answered = own_answered     # () -> [(service, port, client)] answered since
+        self._answered = collections.OrderedDict()     # (service, port) -> its client
         self.service_provider = service_provider
         self._reports = {}                             # node -> NodeReport
         self._called = collections.OrderedDict()       # (service, port) -> client node
@@ -80,7 +85,8 @@ class Board:
                 if self._called.pop(key, None) is None:
                     self._remember(self._served, key, node)
             for key in called:
-                if self._served.pop(key, None) is None:
+                if self._served.pop(key, None) is None and \
+                        self._answered.pop(key, None) is None:
                     self._remember(self._called, key, node)
             self._version += 1
             self._changed.notify_all()
@@ -130,6 +136,7 @@ class Board:
         taken_own, written_own = self.own_counts()
         inbound = self.own_inbound()
         with self._changed:
+            self._absorb_answered()
             for node in nodes:
                 why = self._not_done(node, nodes, taken_own, written_own, inbound)
                 if node in self.silent:
@@ -138,6 +145,11 @@ class Board:
                     continue
                 if why is not None:
                     return why
+            for (service, port), client in list(self._answered.items()):
+                if client in self.silent:
+                    self._answered.pop((service, port), None)
+                elif client in nodes:   # (kept for a client that is not a controller yet)
+                    return client, "no word yet since the simulator answered its %s" % service
             for (service, port), client in list(self._called.items()):
                 server = self.service_provider(service)
                 if server is None or server not in self._reports or server in self.silent \
@@ -146,6 +158,18 @@ class Board:
                     continue
                 return client, "its call to %s not yet answered by %s" % (service, server)
         return None
+
+    def _absorb_answered(self):
+        """The calls the simulator answered: each waits for its client's report of it."""
+        for service, port, client in self.own_answered():
+            if self._called.pop((service, port), None) is None:
+                self._remember(self._answered, (service, port), client)
+
+    def pending_calls(self, nodes):
+        """Whether a call of one of `nodes` to the simulator awaits its client's report."""
+        with self._changed:
+            self._absorb_answered()
+            return any(client in nodes for client in self._answered.values())
 
     def _not_done(self, node, nodes, taken_own, written_own, inbound):
         """(node, why) if `node`'s report does not yet cover what it was sent, else None."""

@@ -9,6 +9,7 @@ install() wraps, in the rospy module of this process:
   rospy.sleep, rospy.timer.sleep     a thread sleeping until a sim time (rospy.Rate, Timer)
   rospy.is_shutdown                  a thread polling
   time.sleep                         a thread waiting for the wall clock: not waited for
+  threading.Condition.wait, notify   a thread handed work by another (queue.Queue, Event)
   ServiceProxy.call                  a service call in flight; its answer read
   ServiceImpl._handle_request        a service handler running
   rospy.init_node                    opens the report publisher
@@ -165,6 +166,28 @@ def install(report=True):
         return wall_sleep(seconds)
     time.sleep = noted_wall_sleep
 
+    # rospy.sleep waits on rospy's time condition: its sleepers are tracked by wake-up time
+    rospy.rostime.get_rostime_cond()._lockstep_untracked = True
+    condition_wait = threading.Condition.wait
+    condition_notify = threading.Condition.notify
+
+    def tracked_wait(self, timeout=None):
+        if getattr(self, "_lockstep_untracked", False):
+            return condition_wait(self, timeout)
+        tid = get_ident()
+        tracker.cond_wait_started(tid, self)
+        try:
+            return condition_wait(self, timeout)
+        finally:
+            tracker.cond_wait_ended(tid, self)
+
+    def tracked_notify(self, n=1):
+        if not getattr(self, "_lockstep_untracked", False):
+            tracker.cond_notified(self, n)
+        return condition_notify(self, n)
+    threading.Condition.wait = tracked_wait
+    threading.Condition.notify = tracked_notify
+
     is_shutdown = rospy.core.is_shutdown
 
     def polled_is_shutdown():
@@ -201,7 +224,8 @@ def install(report=True):
             port = _peer_port(transport)
             return handle_request(self, transport, request)
         finally:
-            tracker.handler_ended(self.resolved_name, port)
+            tracker.handler_ended(self.resolved_name, port,
+                                  getattr(transport, "endpoint_id", None))
     tcpros_service.ServiceImpl._handle_request = tracked_handle_request
 
     # --- the report publisher -----------------------------------------------------------
@@ -217,6 +241,21 @@ def install(report=True):
         return result
     rospy.init_node = rospy.client.init_node = reporting_init_node
     return tracker
+
+
+def proc_watch_instead():
+    """This process sends no reports: lockstep watches it in /proc, as a process outside the
+    project's environment. For a process driven by the wall clock between the simulator's
+    pause and unpause (the Gym environment's ROS backend: its agent thinks while physics is
+    paused, then publishes and unpauses), whose threads' states tell more than its
+    callbacks. Call after rospy.init_node; without the hooks it does nothing."""
+    global _reports, _publisher
+    _reports = False
+    if TRACKER is not None:
+        TRACKER.reporting = lambda: False
+    if _publisher is not None:
+        _publisher.unregister()
+        _publisher = None
 
 
 def watch_only():

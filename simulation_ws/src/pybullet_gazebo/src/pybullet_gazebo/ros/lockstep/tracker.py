@@ -11,7 +11,10 @@ A process is done when
     between: no publish, no sleep, no service call) is a busy loop waiting for something to
     change, and it is done; when a callback or a handler ends it is due again until it has
     polled once more, since what it polls for may have changed;
-  - nothing it published waits in a queued connection's queue.
+  - nothing it published waits in a queued connection's queue;
+  - no thread woken by a threading.Condition (a queue.Queue, an Event) that a callback
+    notified is still at work: a callback that hands a message to another thread (a queue
+    the main loop reads) is done with it only once that thread waits again.
 Each time it becomes done with something new to say, it sends a report (`send`): the
 messages taken in and written out per connection, and the service calls answered and made
 since the last report. The simulator compares those counts with its own (board.py), so it
@@ -27,6 +30,7 @@ bounds the hold for anything the tracker cannot see (a thread timed by the wall 
 import threading
 
 POLL_CAP = 0.05          # [s] wall: the longest a polling thread is held at a time
+KEEP_ANSWERED = 4096     # calls the simulator answered, kept until its board takes them
 
 _POLL, _OTHER = "poll", "other"
 
@@ -37,6 +41,8 @@ class Tracker:
         self.reporting = reporting        # () -> True while the simulator listens
         self._lock = threading.Lock()
         self._changed = threading.Condition(self._lock)   # pollers wait on it
+        self._changed._lockstep_untracked = True          # (its own waits are not news)
+        self._waiting = {}                # id(condition) -> [thread ids waiting, in order]
         self._running = 0                 # callbacks and handlers running
         self._calls = 0                   # service calls in flight
         self._due = set()                 # thread ids due (see the module docstring)
@@ -57,6 +63,7 @@ class Tracker:
         # the simulator's own process counts what it takes in and writes, nothing more: its
         # loop polls rospy.is_shutdown() and must not be taken for a busy loop
         self.counting_only = False
+        self.answered = []                # the simulator's: [(service, port, client)]
         # a process that only watches says so (rospy_hooks.watch_only) and reports no more
         self.watcher = False
 
@@ -90,13 +97,19 @@ class Tracker:
         with self._lock:
             self._running += 1
 
-    def handler_ended(self, service, port):
+    def handler_ended(self, service, port, client=None):
         with self._lock:
-            if self.reporting():
+            if self.counting_only:
+                # the simulator answered a call: it waits for the client's word on it
+                self.answered.append((service, port, client))
+                del self.answered[:-KEEP_ANSWERED]
+            elif self.reporting():
                 self._served.append((service, port))
             self._running -= 1
             self._wake_pollers()
         self._after_change()
+        if self.counting_only and self.on_change is not None:
+            self.on_change()
 
     def call_started(self, tid):
         if self.counting_only:
@@ -109,6 +122,7 @@ class Tracker:
         with self._lock:
             if self.reporting():
                 self._called.append((service, port))
+                self._news = True
 
     def call_ended(self, tid):
         if self.counting_only:
@@ -142,6 +156,39 @@ class Tracker:
             self._due.discard(tid)
             self._last[tid] = _OTHER
         self._after_change()
+
+    def cond_wait_started(self, tid, condition):
+        """Thread `tid` waits on a threading.Condition: done until it is notified."""
+        if self.counting_only:
+            return
+        with self._lock:
+            self._waiting.setdefault(id(condition), []).append(tid)
+            self._due.discard(tid)
+            self._last[tid] = _OTHER
+        self._after_change()
+
+    def cond_wait_ended(self, tid, condition):
+        if self.counting_only:
+            return
+        with self._lock:
+            waiting = self._waiting.get(id(condition))
+            if waiting and tid in waiting:              # it timed out: not woken by anyone
+                waiting.remove(tid)
+                if not waiting:
+                    del self._waiting[id(condition)]
+
+    def cond_notified(self, condition, count):
+        """`count` waiters of `condition` are woken (in the order they came, as CPython
+        does): due until they wait again."""
+        if self.counting_only:
+            return
+        with self._lock:
+            waiting = self._waiting.get(id(condition))
+            if waiting:
+                self._due.update(waiting[:count])
+                del waiting[:count]
+                if not waiting:
+                    del self._waiting[id(condition)]
 
     def wall_sleep(self, tid):
         """Thread `tid` waits for the wall clock: it is timed by the machine, not by sim
@@ -189,6 +236,12 @@ class Tracker:
         self._after_change()
 
     # --- state ---------------------------------------------------------------------------
+    def take_answered(self):
+        """The calls the simulator answered since the last time asked (for its board)."""
+        with self._lock:
+            answered, self.answered = self.answered, []
+            return answered
+
     def counts(self):
         """(taken, written): copies, for the simulator's board."""
         with self._lock:
