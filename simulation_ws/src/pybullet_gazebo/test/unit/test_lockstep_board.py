@@ -162,3 +162,15 @@ def test_a_call_the_simulator_answered_waits_for_its_clients_word():
     assert board.busy({"/env"}) == ("/env", "/cmd_vel not read by the simulator yet")
     own.taken[("/cmd_vel", "/env", 6)] = 1
     assert board.busy({"/env"}) is None and not board.pending_calls({"/env"})
+
+
+def test_a_closed_connection_is_not_waited_for():
+    """The batch runner's next controller, under the same node name on a reused simulator:
+    the scans its predecessor's connection got are not asked of it."""
+    live = {("/scan", "/ctl", 9)}
+    own = Own()
+    board = Board(SIM, own, own_outbound=lambda: live)
+    own.written[("/scan", "/ctl", 5)] = 101                  # the ended process's connection
+    own.written[("/scan", "/ctl", 9)] = 1
+    board.take("/ctl", 2, 1, taken={("/scan", SIM, 9): 1}, written={})
+    assert board.busy({"/ctl"}) is None

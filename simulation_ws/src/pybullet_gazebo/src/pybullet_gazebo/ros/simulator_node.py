@@ -92,7 +92,8 @@ class SimulatorNode:
             own = rospy_hooks.install(report=False)
             self.board = Board(rospy.get_name(), own.counts, ServiceProviders(rospy.get_name()),
                                own_inbound=rospy_hooks.inbound_connections,
-                               own_answered=own.take_answered)
+                               own_answered=own.take_answered,
+                               own_outbound=rospy_hooks.outbound_connections)
             own.on_change = self.board.notify
             # no Nagle on the reports: a report held back for the last one's ACK would hold
             # the simulation for the receiver's delayed ACK

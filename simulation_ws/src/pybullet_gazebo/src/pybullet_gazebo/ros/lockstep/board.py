@@ -55,7 +55,7 @@ class NodeReport:
 
 class Board:
     def __init__(self, own_name, own_counts, service_provider=lambda service: None,
-                 own_inbound=None, own_answered=lambda: ()):
+                 own_inbound=None, own_answered=lambda: (), own_outbound=None):
         """`own_name`: the simulator's node name; `own_counts()`: (taken, written) of the
         simulator's own connections, keyed as in a report; `service_provider(name)`: the
         node that offers a service, or None; `own_inbound()`: the keys of the simulator's
@@ -63,6 +63,9 @@ class Board:
         self.own_name = own_name
         self.own_counts = own_counts
         self.own_inbound = own_inbound or (lambda: set(own_counts()[0]))
+        # the connections it writes to now: a closed one (a controller that ended, the batch
+        # runner's next one under the same name) is not waited for
+        self.own_outbound = own_outbound or (lambda: set(own_counts()[1]))
         self.own_answered = own_answered     # () -> [(service, port, client)] answered since
         self._answered = collections.OrderedDict()     # (service, port) -> its client
         self.service_provider = service_provider
@@ -135,6 +138,8 @@ class Board:
         (`silent`) is skipped until its reports add up again."""
         taken_own, written_own = self.own_counts()
         inbound = self.own_inbound()
+        outbound = self.own_outbound()
+        written_own = {key: n for key, n in written_own.items() if key in outbound}
         with self._changed:
             self._absorb_answered()
             for node in nodes:

@@ -56,11 +56,22 @@ def install(report=True):
     tracker = TRACKER = Tracker(send=_send, reporting=_reporting if report else lambda: False)
     tracker.counting_only = not report
     get_ident = threading.get_ident
+    in_callback = threading.local()      # .depth: callbacks and handlers this thread is in
     waiting = weakref.WeakSet()          # queued connections with messages not yet written
 
     def pending_writes():
         return any(not q._connection.done for q in list(waiting))
     tracker.pending_writes = pending_writes
+
+    def after_fork():
+        """A warm interpreter's child (m2wr_tools.zygote): nothing of its parent's threads,
+        calls, connections or report publisher is its own."""
+        global _publisher
+        _publisher = None
+        waiting.clear()
+        tracker.start_over()
+        tracker._changed._lockstep_untracked = True
+    os.register_at_fork(after_in_child=after_fork)
 
     # --- taking in ----------------------------------------------------------------------
     receive_callback = rospy.topics._SubscriberImpl.receive_callback
@@ -70,9 +81,11 @@ def install(report=True):
         if topic in NOT_COUNTED:
             return receive_callback(self, msgs, connection)
         tracker.callback_started()
+        in_callback.depth = getattr(in_callback, "depth", 0) + 1
         try:
             return receive_callback(self, msgs, connection)
         finally:
+            in_callback.depth -= 1
             now = rospy.rostime.get_rostime().to_nsec() if topic == "/clock" else None
             tracker.callback_ended(topic, connection.callerid_pub, _local_port(connection),
                                    len(msgs), now)
@@ -182,7 +195,9 @@ def install(report=True):
             tracker.cond_wait_ended(tid, self)
 
     def tracked_notify(self, n=1):
-        if not getattr(self, "_lockstep_untracked", False):
+        # only a callback's or a handler's notify hands a message on; a thread started or
+        # woken by anything else (rospy's own threads) may block next where no hook sees it
+        if getattr(in_callback, "depth", 0) and not getattr(self, "_lockstep_untracked", False):
             tracker.cond_notified(self, n)
         return condition_notify(self, n)
     threading.Condition.wait = tracked_wait
@@ -219,11 +234,13 @@ def install(report=True):
 
     def tracked_handle_request(self, transport, request):
         tracker.handler_started()
+        in_callback.depth = getattr(in_callback, "depth", 0) + 1
         port = 0
         try:
             port = _peer_port(transport)
             return handle_request(self, transport, request)
         finally:
+            in_callback.depth -= 1
             tracker.handler_ended(self.resolved_name, port,
                                   getattr(transport, "endpoint_id", None))
     tcpros_service.ServiceImpl._handle_request = tracked_handle_request
@@ -280,6 +297,18 @@ def inbound_connections():
             continue
         for connection in list(impl.connections):
             keys.add((topic, connection.callerid_pub, _local_port(connection)))
+    return keys
+
+
+def outbound_connections():
+    """{(topic, subscriber, port)} of this process's publisher connections now."""
+    from rospy.impl.registration import get_topic_manager
+    keys = set()
+    for topic, impl in list(get_topic_manager().pubs.items()):
+        if topic in NOT_COUNTED:
+            continue
+        for connection in list(impl.connections):
+            keys.add((topic, connection.endpoint_id, _peer_port(connection)))
     return keys
 
 

@@ -12,9 +12,9 @@ A process is done when
     change, and it is done; when a callback or a handler ends it is due again until it has
     polled once more, since what it polls for may have changed;
   - nothing it published waits in a queued connection's queue;
-  - no thread woken by a threading.Condition (a queue.Queue, an Event) that a callback
-    notified is still at work: a callback that hands a message to another thread (a queue
-    the main loop reads) is done with it only once that thread waits again.
+  - no thread woken through a threading.Condition (a queue.Queue, an Event) by a callback
+    or a handler is still at work: a callback that hands a message to another thread (a
+    queue the main loop reads) is done with it only once that thread waits again.
 Each time it becomes done with something new to say, it sends a report (`send`): the
 messages taken in and written out per connection, and the service calls answered and made
 since the last report. The simulator compares those counts with its own (board.py), so it
@@ -39,6 +39,14 @@ class Tracker:
     def __init__(self, send=lambda report: None, reporting=lambda: False):
         self.send = send                  # send(report dict): to the simulator
         self.reporting = reporting        # () -> True while the simulator listens
+        self.pending_writes = lambda: 0   # messages waiting in queued connections
+        self.on_change = None             # called (no lock held) when `taken` grows
+        self.counting_only = False
+        self.start_over()
+
+    def start_over(self):
+        """Forgets every thread, call and count: for a process just forked from another (the
+        batch runner's warm interpreters), whose threads and connections are not its own."""
         self._lock = threading.Lock()
         self._changed = threading.Condition(self._lock)   # pollers wait on it
         self._changed._lockstep_untracked = True          # (its own waits are not news)
@@ -49,7 +57,6 @@ class Tracker:
         self._sleeping = {}               # thread id -> (start, wake, duration) [ns sim]
         self._last = {}                   # thread id -> _POLL or _OTHER: its last event
         self._held = set()                # polling threads held now
-        self.pending_writes = lambda: 0   # messages waiting in queued connections
         self.taken = {}                   # (topic, peer, port) -> messages taken in
         self._dropped = {}                # (topic, port) -> dropped by queue_size
         self.written = {}                 # (topic, peer, port) -> messages written
@@ -59,10 +66,8 @@ class Tracker:
         self._sent_taken = {}             # the counts as last reported
         self._sent_written = {}
         self.seq = 0
-        self.on_change = None             # called (no lock held) when `taken` grows
         # the simulator's own process counts what it takes in and writes, nothing more: its
         # loop polls rospy.is_shutdown() and must not be taken for a busy loop
-        self.counting_only = False
         self.answered = []                # the simulator's: [(service, port, client)]
         # a process that only watches says so (rospy_hooks.watch_only) and reports no more
         self.watcher = False
