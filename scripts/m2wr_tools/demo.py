@@ -11,7 +11,7 @@ unpaused for --duration seconds of sim time, with a progress line every ~2 s of 
 physics paused, everything stopped (SIGINT, then SIGTERM/SIGKILL; no process left behind) ->
 a top-down picture <output>/demo_<world>.png, a replay of the run in the browser view
 <output>/demo_<world>_replay.html (opens from disk: the robot, its path and its laser over a
-time slider; m2wr_tools.replays), a summary printed and written to
+time slider; m2wr_tools.analysis.replays), a summary printed and written to
 <output>/demo_<world>.json, and with --bag <output>/demo_<world>.bag (/m2wr/laser/scan,
 /odom, /cmd_vel). Child logs and ROS logs go to <output>/logs/demo/.
 
@@ -25,14 +25,15 @@ import os
 import sys
 import time
 
-from . import processes, summary
-from .processes import raise_on_signals
+from .running import processes
+from .analysis import summary
+from .running.processes import raise_on_signals
 from .names import (COMMAND_TOPIC, CONTROLLER_NODE, DEFAULT_START, DEFAULT_WORLD, ODOM_TOPIC,
                     PAUSE_SERVICE, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC, SIMULATOR_NODE,
                     UNPAUSE_SERVICE)
 from .paths import ROOT
-from .scene import SCAN_HEIGHT
-from .session import Session, SessionError
+from .analysis.scene import SCAN_HEIGHT
+from .running.session import Session, SessionError
 from .tool_exit import exit_status
 
 BAG_TOPICS = (SCAN_TOPIC, ODOM_TOPIC, COMMAND_TOPIC)
@@ -102,8 +103,8 @@ def say(text):
 def run(args, session, paths):
     """The ROS part; returns what the offline part needs."""
     import rospy
-    from .gazebo import call_empty, model_poses
-    from .recorder import Recorder
+    from .running.gazebo import call_empty, model_poses
+    from .running.recorder import Recorder
 
     realtime = args.realtime or args.gui or args.web
     say("starting a ROS master on a free port")
@@ -179,8 +180,8 @@ def _wait_for_bag(session, timeout=15.0):
 def analyse(args, data, paths):
     """The offline part: clearance, picture, summary."""
     import numpy as np
-    from . import picture, replays
-    from .scene import Scene
+    from .analysis import picture, replays
+    from .analysis.scene import Scene
     from pybullet_gazebo.engine.transforms import Pose
 
     recorder, start, end = data["recorder"], data["start"], data["end"]

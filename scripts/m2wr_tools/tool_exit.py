@@ -22,7 +22,7 @@ class BadInput(Exception):
 
 
 def exit_status(tool, body, interrupted="", known=(), bad_input=(), catch_all=False):
-    from .processes import Interrupted
+    from .running.processes import Interrupted
 
     def say(text):
         sys.stderr.write("%s: %s\n" % (tool, text))

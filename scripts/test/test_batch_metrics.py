@@ -1,11 +1,11 @@
-"""m2wr_tools.metrics: a batch run's figures from recorded data, and the task verdicts."""
+"""m2wr_tools.analysis.metrics: a batch run's figures from recorded data, and the task verdicts."""
 import math
 
 import numpy as np
 import pytest
 
-from m2wr_tools import metrics
-from m2wr_tools.metrics import Task
+from m2wr_tools.analysis import metrics
+from m2wr_tools.analysis.metrics import Task
 
 
 def straight_track(speed=0.5, duration=10.0, rate=20.0):

@@ -1,10 +1,10 @@
-"""m2wr_tools.summary: the run summary's maths and text."""
+"""m2wr_tools.analysis.summary: the run summary's maths and text."""
 import math
 
 import pytest
 
-from m2wr_tools import summary
-from m2wr_tools.summary import Collision, RunSummary
+from m2wr_tools.analysis import summary
+from m2wr_tools.analysis.summary import Collision, RunSummary
 
 
 def test_case_lines_are_recognised():

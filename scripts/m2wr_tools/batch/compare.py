@@ -1,7 +1,7 @@
 """Side by side: the batches of several controllers over the same scenarios, as a Markdown
 table (the README's comparison of the learned policy with obstacle_avoidance.py).
 
-    python -m m2wr_tools.compare "learned=output/cmp/learned_world02" \
+    python -m m2wr_tools.batch.compare "learned=output/cmp/learned_world02" \
                                  "obstacle_avoidance.py=output/cmp/oa_world02"
 
 Each LABEL=FOLDER is a batch folder of scripts/evaluate.sh (its results.json). The batches

@@ -1,5 +1,5 @@
 """Speed figures of m2wr_gym's environments (printed, never asserted):
-`python -m m2wr_tools.gym_bench`.
+`python -m m2wr_tools.bench.gym`.
 
 1. One in-process environment (world02, 10 Hz control, 720-beam scan, random continuous
    actions drawn before the timing, the same three episodes from random free starts in
@@ -48,7 +48,7 @@ from gymnasium.vector import AsyncVectorEnv
 from m2wr_gym import actions
 from m2wr_gym.shared_vector import SharedMemoryVectorEnv, children_ignore_ctrl_c
 
-from .processes import cpu_seconds
+from ..running.processes import cpu_seconds
 
 KWARGS = dict(world="world02", start="random", observation="scan", action="continuous",
               control_rate=10.0, max_episode_seconds=120.0, end_on_contact=False)

@@ -4,7 +4,7 @@ publishing from its own 20 Hz rospy.Rate loop) takes m2wr from (0, 8) to the goa
 at real_time_factor 0, as the bug2_*.test rostests run it.
 
   scripts/bench.sh --bug [--worlds world02 world03] [--output output/]
-  (or: python -m m2wr_tools.bench_bug ...)
+  (or: python -m m2wr_tools.bench.bug ...)
 
 Prints per world: sim time and wall time from the robot's placement to `goal reached`, their
 ratio (x real time), whether lockstep ever timed out (`no cmd_vel within` in the simulator's
@@ -22,11 +22,11 @@ import sys
 import threading
 import time
 
-from . import processes
-from .processes import raise_on_signals
-from .names import CONTACTS_TOPIC, ROSOUT_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH
-from .session import Session, SessionError
-from .tool_exit import exit_status
+from ..running import processes
+from ..running.processes import raise_on_signals
+from ..names import CONTACTS_TOPIC, ROSOUT_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH
+from ..running.session import Session, SessionError
+from ..tool_exit import exit_status
 
 # world: (legacy_mode, the controllers' turn_sign, goal), as bug2_world02/03.test run them
 RUNS = {

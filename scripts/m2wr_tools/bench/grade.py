@@ -9,7 +9,7 @@ series' file names, with a bug2.launch). Like most classes, it hands in no bug 0
 those two tasks fail at once ("no launch file"), as they would for a real student.
 
 Overhead [s wall] is a run's wall time less the part in which the world ran (the record's
-overhead_s, see m2wr_tools.rig: resetting the world, starting and stopping the controller,
+overhead_s, see m2wr_tools.batch.rig: resetting the world, starting and stopping the controller,
 measuring) plus, for the grader, what it adds around the run (grader_s: the student's files
 copied in and out, the rules' last look, the end by PID). Medians: a worker's first run also
 starts its simulator. The comparison is like for like: the class graded again on the spec's
@@ -35,7 +35,7 @@ import subprocess
 import sys
 import time
 
-from .paths import ROOT
+from ..paths import ROOT
 
 SERIES_STYLE = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "test", "series_style")
 TUTORIAL = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "scripts",
@@ -81,7 +81,7 @@ DURATION = 60.0                  # [s sim] ... and its duration
 def write_one_task_spec(path, task):
     """The default spec with only `task` in it, written to `path`."""
     import yaml
-    from .grade.spec import DEFAULT_SPEC
+    from ..grade.spec import DEFAULT_SPEC
     with open(DEFAULT_SPEC) as source:
         spec = yaml.safe_load(source)
     spec["tasks"] = [t for t in spec["tasks"] if t["name"] == task]
@@ -177,7 +177,7 @@ def bench(args):
         # one seed (a new seed relaunches the simulator, as the class's runs never do),
         # starts drawn at random in the free space: as many runs as the class had students
         evaluate_out = os.path.join(output, "bench_grade_evaluate%s" % suffix)
-        _run([sys.executable, "-m", "m2wr_tools.evaluate", "--controller", TUTORIAL,
+        _run([sys.executable, "-m", "m2wr_tools.batch.evaluate", "--controller", TUTORIAL,
               "--task", "wander", "--world", "world02", "--duration", str(DURATION),
               "--seeds", "0", "--random", str(max(2, len(names))), "--pose-seed", str(index),
               "--output", evaluate_out, "--fresh", "--no-progress"] + workers,

@@ -1,6 +1,6 @@
 """A stand-in for browser pages watching the live view (web:=true), for the bench:
 
-  python -m m2wr_tools.web_watch URL [--pages N]
+  python -m m2wr_tools.bench.web_watch URL [--pages N]
 
 opens N WebSockets to URL (ws://127.0.0.1:PORT/ws), trying again every 0.2 s until the
 simulator serves them, and reads every message as a page does (JSON-decoded); on SIGTERM or
@@ -52,7 +52,7 @@ async def _main(args):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m m2wr_tools.web_watch",
+    parser = argparse.ArgumentParser(prog="python -m m2wr_tools.bench.web_watch",
                                      description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     parser.add_argument("url", help="the live view's WebSocket, ws://127.0.0.1:PORT/ws")

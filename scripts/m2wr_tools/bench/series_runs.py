@@ -3,7 +3,7 @@
 turns, nothing tuned for this simulator), run in lockstep and at real time, with what a
 learner would see: reached or not, sim time to the goal, contact events, where it ended.
 
-    python -m m2wr_tools.series_runs --program go_to_point --goal -3 7 \\
+    python -m m2wr_tools.bench.series_runs --program go_to_point --goal -3 7 \\
         [--start 0 8 0] [--world world02] [--modes lockstep real-time] [--repeat 1]
         [--rate 20] [--duration 60] [--clock-hz 100] [--json PATH]
 
@@ -26,12 +26,12 @@ import time
 from dataclasses import asdict, dataclass, field
 from typing import Optional, Tuple
 
-from . import gazebo_calls
-from .gazebo import call_empty
-from .names import PAUSE_SERVICE, UNPAUSE_SERVICE, WORLD_PROPERTIES_SERVICE
-from .processes import raise_on_signals
-from .session import Session, SessionError
-from .tool_exit import exit_status
+from ..running import gazebo_calls
+from ..running.gazebo import call_empty
+from ..names import PAUSE_SERVICE, UNPAUSE_SERVICE, WORLD_PROPERTIES_SERVICE
+from ..running.processes import raise_on_signals
+from ..running.session import Session, SessionError
+from ..tool_exit import exit_status
 
 # program -> (launch file in motion_plan/test/series_style, the switch service the run calls
 # or None when the program switches its own behaviours, its nodes' connections to the
@@ -244,7 +244,7 @@ class SeriesSession:
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m m2wr_tools.series_runs",
+    parser = argparse.ArgumentParser(prog="python -m m2wr_tools.bench.series_runs",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("--program", choices=sorted(PROGRAMS), default="go_to_point")
     parser.add_argument("--goal", type=float, nargs=2, metavar=("X", "Y"))

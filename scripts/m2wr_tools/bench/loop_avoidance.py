@@ -5,7 +5,7 @@ case. Same node name (reading_laser), topics, rules and log lines as the tutoria
 only what makes it act differs. The benchmark measures lockstep with it beside the tutorial's
 own program (a loop program against a scan-answering one).
 
-    python -m m2wr_tools.loop_avoidance [_rate:=20] [_timer:=true]
+    python -m m2wr_tools.bench.loop_avoidance [_rate:=20] [_timer:=true]
 
 With `_timer:=true` a rospy.Timer at the same rate acts instead of the loop.
 """
@@ -13,7 +13,7 @@ import rospy
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import LaserScan
 
-from . import tutorial_scripts
+from .. import tutorial_scripts
 
 
 def main():

@@ -2,7 +2,8 @@
 process (the engine of the ROS simulator, in lockstep semantics: each controller answers
 every decision at the sim time it would in lockstep), through m2wr_gym's environment.
 
-    python -m m2wr_tools.gym_evaluate --policy FILE.npz --world world02 --runs 40 --seconds 120
+    python -m m2wr_tools.batch.gym_evaluate --policy FILE.npz --world world02 --runs 40 \
+        --seconds 120
 
 Start poses: `runs` free poses drawn from --start-seed by the environment's free-pose
 sampler (the same list for both controllers). The tutorial's program is loaded from
@@ -28,8 +29,8 @@ from m2wr_gym import geometry, observation, resources
 from m2wr_gym.env import M2wrEnv
 from m2wr_gym.policy import PolicyFileError, load
 
-from . import tutorial_scripts
-from .tool_exit import exit_status
+from .. import tutorial_scripts
+from ..tool_exit import exit_status
 
 STUCK_WINDOW = 1.0          # [s]
 STUCK_DISTANCE = 0.1        # [m]

@@ -9,7 +9,7 @@
   scripts/evaluate.sh --bench-memory [--bench-runs 200] [--duration 5]
 
 Runs every combination of world x start x seed (lockstep, headless, as fast as the machine
-allows; see m2wr_tools.rig for what one run does), then writes <output>/results.json and
+allows; see m2wr_tools.batch.rig for what one run does), then writes <output>/results.json and
 results.csv (one record a run: scenario, success and why, time to goal, distance, minimum
 clearance, contact events and time in contact, time stuck, path, final pose, wall time,
 real-time factor, the controller's exit status and log), prints the summary table, and draws
@@ -32,7 +32,7 @@ the workers and simulators over the runs (figures printed, not asserted).
 with reuse; prints the resident memory of the worker, its simulator and its controller
 zygote at runs 1, 50, 100, 150, 200 and the slope [MiB per 100 runs] after run 20.
 
-Python controllers are forked from a warm process (m2wr_tools.zygote: rospy already
+Python controllers are forked from a warm process (m2wr_tools.running.zygote: rospy already
 imported; the script itself still starts afresh each run); --cold-start starts them as
 plain processes.
 
@@ -49,12 +49,12 @@ import sys
 import time
 
 from . import results
-from .metrics import TASKS, Task
-from .names import DEFAULT_START, DEFAULT_WORLD, TUTORIAL_CONTROLLER
-from .paths import ROOT
+from ..analysis.metrics import TASKS, Task
+from ..names import DEFAULT_START, DEFAULT_WORLD, TUTORIAL_CONTROLLER
+from ..paths import ROOT
 from .rig import RunOptions
 from .scenarios import FREE_MARGIN, check_starts, combinations, grid_starts, random_starts
-from .tool_exit import BadInput, exit_status
+from ..tool_exit import BadInput, exit_status
 
 
 def parse_args(argv):
@@ -157,7 +157,7 @@ def controller_argv(text):
 def check_worlds(worlds):
     """ValueError naming the first world that has no world file, with the known ones."""
     from pybullet_gazebo.engine.sdf_world import WorldFileError
-    from .paths import world_path
+    from ..paths import world_path
     for world in worlds:
         try:
             world_path(world)
@@ -168,7 +168,7 @@ def check_worlds(worlds):
 
 def build_scenarios(args, outlines_of):
     """The batch's scenarios; ValueError naming a bad world, controller or start."""
-    from .commands import check
+    from ..running.commands import check
     check_worlds(args.world)
     controller = controller_argv(args.controller)
     check(controller, os.environ)
@@ -195,7 +195,7 @@ class _Outlines:
 
     def __call__(self, world):
         if world not in self.cache:
-            from .scene import SCAN_HEIGHT, Scene
+            from ..analysis.scene import SCAN_HEIGHT, Scene
             scene = Scene.of_world(world)
             try:
                 self.cache[world] = scene.outlines(SCAN_HEIGHT)
@@ -212,7 +212,7 @@ def report(args, records, outlines_of, scenarios):
     label = os.path.basename(scenarios[0].controller[-1]) if scenarios else ""
     print(results.summary_table(records, title="%s, task %s, %g s sim each" % (
         label, args.task, args.duration)), flush=True)
-    from . import batch_picture
+    from ..analysis import batch_picture
     pictures = []
     for world in args.world:
         label_world = scenarios[0].world_label if len(args.world) == 1 else \
@@ -245,7 +245,7 @@ def report(args, records, outlines_of, scenarios):
 
 def bench(args):
     """Runs/min for 1 and 2 workers with and without reuse on the same runs."""
-    from .batch import run_batch
+    from .cluster import run_batch
     outlines_of = _Outlines()
     args.world, args.random, args.start, args.grid = [DEFAULT_WORLD], args.bench_runs, None, None
     scenarios = build_scenarios(args, outlines_of)
@@ -369,7 +369,7 @@ def _cpu_medians(records):
 
 def bench_memory(args):
     """Resident memory of one worker, its simulator and zygote over many short runs."""
-    from .batch import run_batch
+    from .cluster import run_batch
     outlines_of = _Outlines()
     args.world, args.random, args.start, args.grid = [DEFAULT_WORLD], args.bench_runs, None, None
     scenarios = build_scenarios(args, outlines_of)
@@ -450,7 +450,7 @@ def main(argv=None):
 
 
 def evaluate(args):
-    from .batch import run_batch
+    from .cluster import run_batch
     os.makedirs(args.output, exist_ok=True)
     if args.bench:
         return bench(args)

@@ -4,8 +4,8 @@ run the series' go to point: a second node reads /odom, offers go_to_point_switc
 continue` without sleeping. Nobody switches it on. The benchmark measures lockstep with this
 pair against obstacle_avoidance.py alone: a busy loop must not slow the loop down.
 
-    python -m m2wr_tools.switched_off_beside            # both: the behaviour as a child
-    python -m m2wr_tools.switched_off_beside --behaviour # the switched-off node alone
+    python -m m2wr_tools.bench.switched_off_beside            # both: the behaviour as a child
+    python -m m2wr_tools.bench.switched_off_beside --behaviour # the switched-off node alone
 
 The child gets SIGTERM when this process ends, however it ends (PR_SET_PDEATHSIG), and is
 waited for here on a normal exit.
@@ -50,11 +50,11 @@ def main():
         except KeyboardInterrupt:
             pass
         return
-    child = subprocess.Popen([sys.executable, "-m", "m2wr_tools.switched_off_beside",
+    child = subprocess.Popen([sys.executable, "-m", "m2wr_tools.bench.switched_off_beside",
                               "--behaviour"], stdin=subprocess.DEVNULL,
                              preexec_fn=_die_with_parent)
     try:
-        from . import tutorial_scripts
+        from .. import tutorial_scripts
         tutorial_scripts.load("obstacle_avoidance.py").main()
     except KeyboardInterrupt:
         pass

@@ -14,7 +14,7 @@ Figures:
                     touched a model (free-running, the controller's answers come late in sim
                     time and the robot hits barriers: the reason lockstep exists)
   loop program      the same lockstep loop with obstacle_avoidance.py's rules driven by a
-                    rospy.Rate(20) loop of their own (m2wr_tools/loop_avoidance.py), at the
+                    rospy.Rate(20) loop of their own (m2wr_tools/bench/loop_avoidance.py), at the
                     demo's /clock rate (the batch runner's) and at the simulator's default
                     100 Hz (the world launch's): its x real time over obstacle_avoidance.py's
                     at the same clock (target >= 0.9)
@@ -55,7 +55,7 @@ Figures:
                     the controller and each listener (the most robust figure on a shared
                     machine: compare the listeners' CPU between builds)
   --web-only        the lockstep loop without and with the live web page (web:=true) and
-                    --pages pages watching it, ROUNDS times in turn (m2wr_tools.bench_web)
+                    --pages pages watching it, ROUNDS times in turn (m2wr_tools.bench.web)
 The machine is shared: the load average before and after is recorded with the figures.
 
 Where the simulator's time goes (profile recipe): run the loop (scripts/demo.sh, or
@@ -83,16 +83,16 @@ import platform
 import statistics
 import sys
 
-from . import benchmath
-from .processes import raise_on_signals
-from .bench_engine import engine_figures
-from .bench_loop import (BUSY_PROGRAM, LOOP_PROGRAM, WORLD, START, Listener, launch_to_first_scan,
+from . import arithmetic
+from ..running.processes import raise_on_signals
+from .engine import engine_figures
+from .loop import (BUSY_PROGRAM, LOOP_PROGRAM, WORLD, START, Listener, launch_to_first_scan,
                          measure_loop,
                          say, soak)
-from .benchmath import fmt
-from .paths import ROOT
-from .session import Session, SessionError
-from .tool_exit import exit_status
+from .arithmetic import fmt
+from ..paths import ROOT
+from ..running.session import Session, SessionError
+from ..tool_exit import exit_status
 
 SIMULATOR_DEFAULT_CLOCK_HZ = 100.0
 UNLIMITED = "listeners, watch_rate 0"
@@ -126,7 +126,7 @@ def report(figures):
     lines = ["", "m2wr stand-in benchmark (%s, %d cores, load %s before, %s after)" % (
         WORLD, figures["machine"]["cores"], figures["machine"]["load_before"],
         figures["machine"]["load_after"]),
-        benchmath.table(names, [(label, *cells) for label, cells in rows])]
+        arithmetic.table(names, [(label, *cells) for label, cells in rows])]
     engine = figures["engine"]
     lines += [
         "",
@@ -393,7 +393,7 @@ def main(argv=None):
         rospy_hooks.watch_only()
         listener = Listener()
         if args.web_only:
-            from .bench_web import web_rounds
+            from .web import web_rounds
             figures["web_rounds"] = web_rounds(session, listener, args)
         elif args.listeners_only:
             figures["listener_rounds"] = listener_rounds(session, listener, args)
@@ -415,7 +415,7 @@ def main(argv=None):
     if figures.get("listener_rounds"):
         print(rounds_report(figures), flush=True)
     if figures.get("web_rounds"):
-        from .bench_web import web_report
+        from .web import web_report
         print(web_report(figures), flush=True)
     if "engine" in figures:
         print(report(figures) if figures["loop"] else "", flush=True)
