@@ -26,7 +26,7 @@ import sys
 import time
 
 from .running import processes
-from .analysis import summary
+from .analysis import metrics, summary
 from .running.processes import raise_on_signals
 from .names import (COMMAND_TOPIC, CONTROLLER_NODE, DEFAULT_START, DEFAULT_WORLD, ODOM_TOPIC,
                     PAUSE_SERVICE, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC, SIMULATOR_NODE,
@@ -221,7 +221,7 @@ def analyse(args, data, paths):
                  title=title)
     result = summary.RunSummary(
         world=world_label(args.world), start=(args.x, args.y, args.yaw), sim_time=end - start,
-        wall_time=data["wall"], distance=summary.distance_travelled(track[:, 1:3]),
+        wall_time=data["wall"], distance=metrics.distance_travelled(track[:, 1:3]),
         collisions=collisions,
         cases=summary.case_durations(recorder.cases, start, end), picture=paths["picture"],
         bag=paths["bag"] if args.bag else "", replay=replay)

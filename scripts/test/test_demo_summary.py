@@ -39,12 +39,6 @@ def test_case_order_is_numeric_not_alphabetical():
                                                             "unknown case"]
 
 
-def test_distance_travelled_is_the_polyline_length():
-    assert summary.distance_travelled([(0, 0), (3, 4), (3, 4), (3, 0)]) == pytest.approx(9.0)
-    assert summary.distance_travelled([(1, 1)]) == 0.0
-    assert summary.distance_travelled([]) == 0.0
-
-
 def test_collisions_count_onsets_not_contact_messages():
     updates = [(1.0, [("m2wr", "wall")]), (1.1, [("m2wr", "wall"), ("m2wr", "barrel")]),
                (1.5, []), (2.0, [("m2wr", "wall")])]

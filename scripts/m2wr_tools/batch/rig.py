@@ -584,7 +584,7 @@ class Rig:
             distances = np.array([c.distance for c in clearances])
             nearest = clearances[int(np.argmin(distances))] if len(clearances) else None
             wall_share = metrics.fraction_within(distances, task.wall_near, task.wall_far)
-        distance = metrics.distance(track[:, 1:3])
+        distance = metrics.distance_travelled(track[:, 1:3])
         success, reason = metrics.judge(task, distance, events, goal_time, wall_share)
         path = metrics.decimate(track, PATH_PERIOD)
         result = {
