@@ -5,6 +5,7 @@ and what they share, one sub-package a job. Index:
   names             topic, node, service and launch names the tools look up
   paths             the checkout's root, world files, model folders, the robot's URDF
   tool_exit         how every tool ends: one line on stderr and an exit status
+  usage             how every tool answers --help: its name as typed, defaults, examples
   tutorial_scripts  motion_plan's scripts (the tutorial's programs) loaded as modules
 
   running/          ROS processes: start them, talk to them, stop them
@@ -55,7 +56,7 @@ and what they share, one sub-package a job. Index:
 
   grade/            the class grader (scripts/grade.sh); its own index in grade/__init__.py
 
-Layers, from the ground up: names, paths, tool_exit and tutorial_scripts; analysis/ (none
+Layers, from the ground up: names, paths, tool_exit, usage and tutorial_scripts; analysis/ (none
 of running/, batch/, bench/); running/ (analysis/ only for the recorder's case lines); batch/;
 grade/ (on batch/); bench/ and demo, the commands, on top. Geometry (poses, quaternions, yaw) is the engine's:
 pybullet_gazebo.engine.transforms. The tools stand above the project's ROS packages and use

@@ -39,7 +39,6 @@ plain processes.
 Exit status: 0 when the batch finished (failed runs included); 1 when it could not run;
 2 for bad arguments; 130 when interrupted.
 """
-import argparse
 import json
 import math
 import os
@@ -55,43 +54,48 @@ from ..paths import ROOT
 from .rig import RunOptions
 from .scenarios import FREE_MARGIN, check_starts, combinations, grid_starts, random_starts
 from ..tool_exit import BadInput, exit_status
+from .. import usage
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="evaluate.sh", description=__doc__.split("\n\n")[0])
+    parser = usage.parser("scripts/evaluate.sh", __doc__, examples=[
+        "scripts/evaluate.sh --random 40 --duration 60    # obstacle_avoidance.py, 40 free starts",
+        "scripts/evaluate.sh --controller my_controller.py --grid 2 --seeds 0 1 --world world01",
+        "scripts/evaluate.sh --controller ~/go_to_point.py --task goal --goal 2 -3"])
     parser.add_argument("--controller", default=" ".join(TUTORIAL_CONTROLLER),
                         help="the controller: a command line (rosrun/roslaunch ...) or a path "
-                        "to a script (default: the tutorial's obstacle_avoidance.py)")
+                        "to a script")
     parser.add_argument("--task", choices=TASKS, default="wander",
                         help="wander: no contact and --min-distance travelled over the "
                         "duration; goal: reach --goal within --tolerance; wall: follow a wall")
     parser.add_argument("--goal", type=float, nargs=2, metavar=("X", "Y"),
                         help="goal [m] of the goal task (set as the des_pos_x/des_pos_y params)")
-    parser.add_argument("--tolerance", type=float, default=0.3, help="goal radius [m] (0.3)")
+    parser.add_argument("--tolerance", type=float, default=0.3, help="goal radius [m]")
     parser.add_argument("--min-distance", type=float, default=1.0,
-                        help="wander/wall: least distance [m] a successful run travels (1)")
+                        help="wander/wall: least distance [m] a successful run travels")
     parser.add_argument("--world", action="append", help="world01, world02 or a .world path "
-                        "(repeatable; default world02)")
+                        "(repeatable) (default: world02)")
     parser.add_argument("--start", type=float, nargs=3, action="append",
-                        metavar=("X", "Y", "YAW"), help="a start pose [m m rad] (repeatable)")
+                        metavar=("X", "Y", "YAW"), help="a start pose [m m rad] (repeatable) "
+                        "(default: the tutorial's 0 8 0)")
     parser.add_argument("--grid", type=float, metavar="STEP",
                         help="starts on a grid of STEP m over free space (heading 0)")
     parser.add_argument("--random", type=int, metavar="N", help="N random free start poses")
     parser.add_argument("--pose-seed", type=int, default=0,
-                        help="seed of the --random poses (default 0)")
+                        help="seed of the --random poses")
     parser.add_argument("--margin", type=float, default=FREE_MARGIN,
-                        help="free space: least distance [m] of a start from any obstacle "
-                        "(default %g)" % FREE_MARGIN)
+                        help="free space: least distance [m] of a start from any obstacle")
     parser.add_argument("--seeds", type=int, nargs="+", default=[0],
-                        help="simulator seeds (laser noise), one run each (default 0)")
+                        help="simulator seeds (laser noise), one run each (default: 0)")
     parser.add_argument("--duration", type=float, default=None,
-                        help="sim time of a run [s] (default 60; 5 with --bench-memory)")
-    parser.add_argument("--workers", type=int, help="LocalCluster workers (default: cores)")
+                        help="sim time of a run [s] (default: 60; 5 with --bench-memory)")
+    parser.add_argument("--workers", type=int, help="LocalCluster workers (default: one per core)")
     parser.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. "
                         "tcp://127.0.0.1:8786 (its workers need this project set up, "
-                        "scripts/env.sh sourced and --nthreads 1)")
+                        "scripts/env.sh sourced and --nthreads 1) (default: a LocalCluster on "
+                        "this machine)")
     parser.add_argument("--output", default=os.path.join(ROOT, "output", "evaluate"),
-                        help="folder of results, pictures and logs (default output/evaluate)")
+                        help="folder of results, pictures and logs (default: output/evaluate)")
     parser.add_argument("--no-reuse", action="store_true",
                         help="relaunch the simulator for every run")
     parser.add_argument("--bag", action="store_true", help="a rosbag per run in <output>/runs/")
@@ -103,15 +107,15 @@ def parse_args(argv):
     parser.add_argument("--fresh", action="store_true",
                         help="ignore the runs already in <output>/results.json")
     parser.add_argument("--connect-timeout", type=float, default=20.0,
-                        help="wall seconds for the controller to publish cmd_vel (20)")
+                        help="wall seconds for the controller to publish cmd_vel")
     parser.add_argument("--run-timeout", type=float, default=0.0,
-                        help="wall seconds a run may take (default 60 + 2 x duration)")
+                        help="wall seconds a run may take (default: 60 + 2 x duration)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    parser.add_argument("--bench", action="store_true", help="the batch benchmark (above)")
+    parser.add_argument("--bench", action="store_true", help="the batch benchmark (see above)")
     parser.add_argument("--bench-memory", action="store_true",
-                        help="the memory benchmark (above)")
+                        help="the memory benchmark (see above)")
     parser.add_argument("--bench-runs", type=int, default=None,
-                        help="runs of the benchmark (20; 200 with --bench-memory)")
+                        help="runs of the benchmark (default: 20; 200 with --bench-memory)")
     parser.add_argument("--cold-start", action="store_true",
                         help="start Python controllers as plain processes, not from the "
                         "warm zygote")

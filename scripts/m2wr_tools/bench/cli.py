@@ -75,7 +75,6 @@ clock_topic.py) that line was 24 % of the main thread, half of it /clock to the 
 `-f raw` writes one line per stack: grep the main thread's (they start with "<module>
 (gazebo_world") and sum by function.
 """
-import argparse
 import json
 import math
 import os
@@ -93,6 +92,7 @@ from .arithmetic import fmt
 from ..paths import ROOT
 from ..running.session import Session, SessionError
 from ..tool_exit import exit_status
+from .. import usage
 
 SIMULATOR_DEFAULT_CLOCK_HZ = 100.0
 UNLIMITED = "listeners, watch_rate 0"
@@ -312,36 +312,44 @@ def rounds_report(figures):
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="bench.sh", description=__doc__.split("\n\n")[0])
+    parser = usage.parser("scripts/bench.sh", __doc__, examples=[
+        "scripts/bench.sh                         # every figure of episode 5",
+        "scripts/bench.sh --loop-program-only 5   # the loop program's ratio, 5 rounds",
+        "scripts/bench.sh --bug --help            # the series' bug-2 runs: their own options",
+        "scripts/bench.sh --grade --help          # a class graded: its own options"],
+        exit_statuses="Exit status: 0 when the figures were measured (targets are printed, "
+        "not asserted); 1 when a\nrun could not start; 2 for bad arguments; 130 when "
+        "interrupted.")
     parser.add_argument("--seconds", type=float, default=15.0,
-                        help="wall seconds of each real-time-factor measurement (default 15)")
+                        help="wall seconds of each real-time-factor measurement (default: 15)")
     parser.add_argument("--check-seconds", type=float, default=5.0,
-                        help="wall seconds of each scan/answer count (default 5)")
+                        help="wall seconds of each scan/answer count (default: 5)")
     parser.add_argument("--clock-hz", type=float, default=20.0,
-                        help="/clock rate the demo uses [Hz sim] (default 20)")
+                        help="/clock rate the demo uses [Hz sim] (default: 20)")
     parser.add_argument("--soak", type=float, default=0.0, metavar="MINUTES",
                         help="also run a soak of MINUTES of wall time (default: none)")
     parser.add_argument("--listeners-only", type=int, default=0, metavar="ROUNDS",
                         help="only the lockstep loop without and with listeners, ROUNDS times "
                              "in turn (the listener target's ratio per round and its median); "
-                             "no engine, free-running or launch figures")
+                             "no engine, free-running or launch figures (default: off)")
     parser.add_argument("--loop-program-only", type=int, nargs="?", const=3, default=0,
                         metavar="ROUNDS",
                         help="only obstacle_avoidance.py, the loop program and "
                              "obstacle_avoidance.py beside a busy loop in lockstep, in turn, "
-                             "ROUNDS times (default 3) at --clock-hz and at 100 Hz: each "
-                             "round's ratios and their medians (targets >= 0.9 and >= 0.8)")
+                             "ROUNDS times (3 when ROUNDS is left out) at --clock-hz and at 100 Hz: "
+                             "each round's ratios and their medians (targets >= 0.9 and >= 0.8) "
+                             "(default: off)")
     parser.add_argument("--web-only", type=int, default=0, metavar="ROUNDS",
                         help="only the lockstep loop without and with the live web page watched "
                              "by --pages pages, ROUNDS times in turn (ratio per round, median; "
-                             "target >= 90 %%)")
+                             "target >= 90 %%) (default: off)")
     parser.add_argument("--pages", type=int, default=1,
-                        help="with --web-only: pages watching at once (default 1)")
+                        help="with --web-only: pages watching at once (default: 1)")
     parser.add_argument("--watch-rate", type=float, default=None, metavar="HZ",
                         help="with --listeners-only: the simulator's ~watch_rate (default: its "
                              "own, 30)")
     parser.add_argument("--output", default=os.path.join(ROOT, "output"),
-                        help="folder for bench.json and logs (default output/)")
+                        help="folder for bench.json and logs (default: output/)")
     args = parser.parse_args(argv)
     for name in ("seconds", "check_seconds", "clock_hz"):
         if not (math.isfinite(getattr(args, name)) and getattr(args, name) > 0):

@@ -26,7 +26,6 @@ beside an ep5 run, which slowed its start by 10-30 ms and moved the ratio betwee
 
 Prints the figures and writes <output>/bench_grade.json.
 """
-import argparse
 import json
 import os
 import shutil
@@ -36,6 +35,7 @@ import sys
 import time
 
 from ..paths import ROOT
+from .. import usage
 
 SERIES_STYLE = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "test", "series_style")
 TUTORIAL = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "scripts",
@@ -226,13 +226,23 @@ def bench(args):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="bench_grade", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--students", type=int, default=30)
-    parser.add_argument("--workers", type=int, default=None, help="default: cores")
+    parser = usage.parser("scripts/bench.sh --grade", __doc__, examples=[
+        "scripts/bench.sh --grade                 # 30 students, one worker per core",
+        "scripts/bench.sh --grade --students 4 --rounds 1 --output /tmp/grade-bench"],
+        exit_statuses="Exit status: 0 when the figures were measured; 1 when the grader or "
+        "the batch runner failed\n(the step is named); 2 for bad arguments; 130 when "
+        "interrupted.")
+    parser.add_argument("--students", type=int, default=30,
+                        help="students in the class made for the benchmark")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="Dask workers of the grader and the batch runner "
+                        "(default: one per core)")
     parser.add_argument("--rounds", type=int, default=2,
                         help="rounds of the like-for-like comparison, grader and batch runner "
-                             "in turn (default 2); the ratio is of all rounds' runs")
-    parser.add_argument("--output", default=os.path.join(ROOT, "output"))
+                             "in turn; the ratio is of all rounds' runs")
+    parser.add_argument("--output", default=os.path.join(ROOT, "output"),
+                        help="folder for bench_grade.json, the class, its report and logs "
+                        "(default: output/)")
     args = parser.parse_args(argv)
     try:
         bench(args)
