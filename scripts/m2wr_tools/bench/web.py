@@ -2,7 +2,7 @@
 page costs the lockstep loop (target: at most 10 %, as for the rviz-like listeners).
 
 Each round measures the lockstep loop of the whole bench (world02, m2wr, obstacle_avoidance.py,
-real_time_factor 0; bench_loop.measure_loop) twice in turn: without the page, then with
+real_time_factor 0; loop.measure_loop) twice in turn: without the page, then with
 web:=true and N pages watching (m2wr_tools.bench.web_watch: WebSockets that read and decode every
 frame as a browser does, without drawing; a browser's drawing is its own process's cost,
 whatever the simulator sends). Printed per round: x real time without and with, the ratio,
