@@ -12,8 +12,8 @@ import pytest
 from m2wr_gym import train
 from m2wr_tools import demo
 from m2wr_tools.batch import compare, evaluate, gym_evaluate
-from m2wr_tools.bench import bug, cli as bench_cli, grade as bench_grade, gym, series_runs, \
-    web_watch
+from m2wr_tools.bench import bug, cli as bench_cli, grade as bench_grade, gym, loop_avoidance, \
+    series_runs, switched_off_beside, web_watch
 from m2wr_tools.grade import cli as grade_cli
 from m2wr_tools.paths import ROOT
 
@@ -31,6 +31,8 @@ PYTHON_TOOLS = [
     ("python -m m2wr_tools.bench.gym", gym.main),
     ("python -m m2wr_tools.bench.series_runs", series_runs.main),
     ("python -m m2wr_tools.bench.web_watch", web_watch.main),
+    ("python -m m2wr_tools.bench.loop_avoidance", loop_avoidance.main),
+    ("python -m m2wr_tools.bench.switched_off_beside", switched_off_beside.main),
 ]
 # the scripts that do more than `exec python -m TOOL "$@"` (bench.sh picks its tool by the
 # first argument; train.sh answers --help before it installs the training extra)
@@ -55,7 +57,8 @@ def undocumented_options(text):
 
 
 # the tools whose every option is required or a flag: nothing to show a default for
-NO_DEFAULTS = {"python -m m2wr_tools.batch.compare"}
+NO_DEFAULTS = {"python -m m2wr_tools.batch.compare", "python -m m2wr_tools.bench.loop_avoidance",
+               "python -m m2wr_tools.bench.switched_off_beside"}
 
 
 def check_help(prog, text):

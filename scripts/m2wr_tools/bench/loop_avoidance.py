@@ -13,10 +13,14 @@ import rospy
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import LaserScan
 
-from .. import tutorial_scripts
+from .. import tutorial_scripts, usage
 
 
-def main():
+def main(argv=None):
+    usage.parser("python -m m2wr_tools.bench.loop_avoidance", __doc__, examples=[
+        "python -m m2wr_tools.bench.loop_avoidance              # a rospy.Rate(20) loop",
+        "python -m m2wr_tools.bench.loop_avoidance _timer:=true _rate:=50"],
+        exit_statuses="Exit status: 0 when ROS shuts the node down.").parse_known_args(argv)
     tutorial = tutorial_scripts.load("obstacle_avoidance.py")
     rospy.init_node("reading_laser")
     hz = rospy.get_param("~rate", 20.0)

@@ -15,6 +15,8 @@ import signal
 import subprocess
 import sys
 
+from .. import usage
+
 PR_SET_PDEATHSIG = 1
 
 
@@ -43,8 +45,14 @@ def _die_with_parent():
     ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
-def main():
-    if "--behaviour" in sys.argv[1:]:
+def main(argv=None):
+    parser = usage.parser("python -m m2wr_tools.bench.switched_off_beside", __doc__, examples=[
+        "python -m m2wr_tools.bench.switched_off_beside              # both nodes"],
+        exit_statuses="Exit status: 0 when ROS shuts the nodes down.")
+    parser.add_argument("--behaviour", action="store_true",
+                        help="run only the switched-off go_to_point node (the child)")
+    args, _ros_args = parser.parse_known_args(argv)
+    if args.behaviour:
         try:
             behaviour()
         except KeyboardInterrupt:
