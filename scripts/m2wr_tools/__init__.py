@@ -54,7 +54,19 @@ and what they share, one sub-package a job. Index:
     grade           scripts/bench.sh --grade: a class graded, runs a minute, the overhead
     gym             m2wr_gym's environments: steps a second
 
-  grade/            the class grader (scripts/grade.sh); its own index in grade/__init__.py
+  grade/            the class grader (scripts/grade.sh), on the batch runner
+    cli             scripts/grade.sh's command line: the batch, the report, replays
+    spec            the YAML spec of the tasks (spec_default.yaml: episodes 5-10)
+    classroom       the class folder: each student's package or loose scripts
+    grading         the class's batch: every submission staged, checked and run on Dask
+    runner          one graded run on a Dask worker (the batch's rig, extended)
+    sandbox         a run's user, limits, watchdog and end
+    rules           what a controller may use of the simulator; findings and the verdict
+    launch_filter   a student's launch file without the world and robot it would start
+    scoring         records -> each student's task scores, total, rank; grades.csv
+    report          the static site: the class table, a page per student, pictures
+    replay          scripts/grade.sh --replay: one graded run again, drawn
+    replay_view     each graded run's replay page in the report
 
 Layers, from the ground up: names, paths, tool_exit, usage and tutorial_scripts; analysis/ (none
 of running/, batch/, bench/); running/ (analysis/ only for the recorder's case lines); batch/;
