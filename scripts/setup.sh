@@ -2,15 +2,25 @@
 # One-command set-up on a fresh Debian 12 machine (root, or a user with sudo).
 #
 #   scripts/setup.sh          install what is missing, then build both catkin workspaces
+#   scripts/setup.sh --help   this text; installs and builds nothing
 #
 # Steps: Debian's ROS 1 packages -> .venv from /usr/bin/python3 (--system-site-packages, so
 # Debian's rospy stays importable) -> pinned PyPI packages -> the tools package (scripts/,
-# editable) -> catkin_make simulation_ws, then
-# catkin_ws on top of it. Idempotent: on a ready machine it only re-checks and re-runs the
-# (incremental) catkin builds.
+# editable) -> catkin_make simulation_ws, then catkin_ws on top of it. Idempotent: on a ready
+# machine it only re-checks and re-runs the (incremental) catkin builds.
+#
+# Exit status: 0 when the project is ready; 1 when a step failed (the step is named); 2 for an
+# unknown option.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+usage() { sed -n '2,/^set /{/^set /d;s/^# \{0,1\}//p}' "${BASH_SOURCE[0]}"; }
+for arg in "$@"; do
+  case "$arg" in
+    -h|--help) usage; exit 0 ;;
+    *) printf 'scripts/setup.sh: unknown option %s\n\n' "$arg" >&2; usage >&2; exit 2 ;;
+  esac
+done
 VENV="$ROOT/.venv"
 SYSTEM_PYTHON=/usr/bin/python3
 STEP="start"

@@ -6,11 +6,23 @@
 #
 #   scripts/test.sh            everything (unit, rostest, the batch runner's cluster tests)
 #   scripts/test.sh --unit     only the pytest unit tests
+#   scripts/test.sh --help     this text; sets up and runs nothing
+#
+# Exit status: 0 when every test passed; 1 when a test failed, a rostest crashed or the set-up
+# failed; 2 for an unknown option.
 set -uo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 RESULTS="$ROOT/test_results"
-mode="${1:-all}"
+usage() { sed -n '2,/^set /{/^set /d;s/^# \{0,1\}//p}' "${BASH_SOURCE[0]}"; }
+mode=all
+for arg in "$@"; do
+  case "$arg" in
+    -h|--help) usage; exit 0 ;;
+    --unit) mode=--unit ;;
+    *) printf 'scripts/test.sh: unknown option %s\n\n' "$arg" >&2; usage >&2; exit 2 ;;
+  esac
+done
 
 bash "$ROOT/scripts/setup.sh" || { echo "[test] setup failed; no test was run"; echo "0 passed, 1 failed"; exit 1; }
 set +u; source "$ROOT/scripts/env.sh"; set -u

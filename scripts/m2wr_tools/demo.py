@@ -11,29 +11,30 @@ unpaused for --duration seconds of sim time, with a progress line every ~2 s of 
 physics paused, everything stopped (SIGINT, then SIGTERM/SIGKILL; no process left behind) ->
 a top-down picture <output>/demo_<world>.png, a replay of the run in the browser view
 <output>/demo_<world>_replay.html (opens from disk: the robot, its path and its laser over a
-time slider; m2wr_tools.replays), a summary printed and written to
+time slider; m2wr_tools.analysis.replays), a summary printed and written to
 <output>/demo_<world>.json, and with --bag <output>/demo_<world>.bag (/m2wr/laser/scan,
 /odom, /cmd_vel). Child logs and ROS logs go to <output>/logs/demo/.
 
 Exit status: 0 on success; 1 when a step fails (the message names the step and shows the
 failing program's own error); 2 for bad arguments; 130 when interrupted.
 """
-import argparse
 import json
 import math
 import os
 import sys
 import time
 
-from . import processes, summary
-from .processes import raise_on_signals
+from .running import processes
+from .analysis import metrics, summary
+from .running.processes import raise_on_signals
 from .names import (COMMAND_TOPIC, CONTROLLER_NODE, DEFAULT_START, DEFAULT_WORLD, ODOM_TOPIC,
                     PAUSE_SERVICE, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC, SIMULATOR_NODE,
                     UNPAUSE_SERVICE)
 from .paths import ROOT
-from .scene import SCAN_HEIGHT
-from .session import Session, SessionError
+from .analysis.scene import SCAN_HEIGHT
+from .running.session import Session, SessionError
 from .tool_exit import exit_status
+from . import usage
 
 BAG_TOPICS = (SCAN_TOPIC, ODOM_TOPIC, COMMAND_TOPIC)
 PROGRESS_PERIOD = 2.0       # [s] wall
@@ -42,40 +43,39 @@ DEFAULT_CLOCK_HZ = 20.0     # [Hz] sim; the simulator also publishes /clock with
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(
-        prog="demo.sh", description="Episode 5 of 'Exploring ROS with a 2 Wheeled Robot': "
-        "obstacle_avoidance.py drives m2wr in the pybullet stand-in; writes a picture and a "
-        "summary.")
+    parser = usage.parser("scripts/demo.sh", __doc__, examples=[
+        "scripts/demo.sh                          # episode 5: world02, m2wr at (0, 8), 120 s",
+        "scripts/demo.sh --web                    # the same at real time, watched in a browser",
+        "scripts/demo.sh --world world01 --x 0 --y 0 --duration 60 --bag"])
     parser.add_argument("--world", default=DEFAULT_WORLD,
-                        help="world01, world02 or a path to a .world file (default world02)")
-    parser.add_argument("--x", type=float, default=DEFAULT_START[0], help="start x [m] (default 0)")
-    parser.add_argument("--y", type=float, default=DEFAULT_START[1], help="start y [m] (default 8, the "
-                        "tutorial's `spawn.launch y:=8`)")
-    parser.add_argument("--yaw", type=float, default=DEFAULT_START[2], help="start heading [rad] (default 0)")
+                        help="world01, world02 or a path to a .world file")
+    parser.add_argument("--x", type=float, default=DEFAULT_START[0], help="start x [m]")
+    parser.add_argument("--y", type=float, default=DEFAULT_START[1], help="start y [m]; 8 is the tutorial's "
+                        "`spawn.launch y:=8`")
+    parser.add_argument("--yaw", type=float, default=DEFAULT_START[2], help="start heading [rad]")
     parser.add_argument("--duration", type=float, default=120.0,
-                        help="sim time to run the controller [s] (default 120)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the laser noise (default 0)")
+                        help="sim time to run the controller [s]")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the laser noise")
     parser.add_argument("--gui", action="store_true",
                         help="open pybullet's window (needs a display); runs at real time")
     parser.add_argument("--web", action="store_true",
                         help="watch the run live in a browser on http://127.0.0.1:WEB_PORT/ "
                         "(no display needed); runs at real time")
     parser.add_argument("--web-port", type=int, default=8090,
-                        help="TCP port of the live page with --web (default 8090)")
+                        help="TCP port of the live page with --web")
     parser.add_argument("--web-host", default="127.0.0.1",
-                        help="address of the live page with --web (default 127.0.0.1, this "
-                        "machine only; 0.0.0.0 in a container whose port is published)")
+                        help="address of the live page with --web: 127.0.0.1 is this machine "
+                        "only; 0.0.0.0 in a container whose port is published")
     parser.add_argument("--realtime", action="store_true",
                         help="run at real time (real_time_factor 1, no lockstep) instead of "
                         "as fast as possible in lockstep")
     parser.add_argument("--bag", action="store_true",
                         help="record /m2wr/laser/scan, /odom, /cmd_vel to <output>/demo_<world>.bag")
     parser.add_argument("--output", default=os.path.join(ROOT, "output"),
-                        help="folder for the picture, summary, bag and logs (default output/)")
+                        help="folder for the picture, summary, bag and logs (default: output/)")
     parser.add_argument("--clock-hz", type=float, default=DEFAULT_CLOCK_HZ,
                         help="/clock rate [Hz of sim time] passed to the simulator as "
-                        "pub_clock_frequency (default %g; the simulator's own default is 100)"
-                        % DEFAULT_CLOCK_HZ)
+                        "pub_clock_frequency; the simulator's own default is 100")
     args = parser.parse_args(argv)
     for name in ("x", "y", "yaw", "duration", "clock_hz"):
         if not math.isfinite(getattr(args, name)):
@@ -102,8 +102,8 @@ def say(text):
 def run(args, session, paths):
     """The ROS part; returns what the offline part needs."""
     import rospy
-    from .gazebo import call_empty, model_poses
-    from .recorder import Recorder
+    from .running.gazebo import call_empty, model_poses
+    from .running.recorder import Recorder
 
     realtime = args.realtime or args.gui or args.web
     say("starting a ROS master on a free port")
@@ -179,8 +179,8 @@ def _wait_for_bag(session, timeout=15.0):
 def analyse(args, data, paths):
     """The offline part: clearance, picture, summary."""
     import numpy as np
-    from . import picture, replays
-    from .scene import Scene
+    from .analysis import picture, replays
+    from .analysis.scene import Scene
     from pybullet_gazebo.engine.transforms import Pose
 
     recorder, start, end = data["recorder"], data["start"], data["end"]
@@ -220,7 +220,7 @@ def analyse(args, data, paths):
                  title=title)
     result = summary.RunSummary(
         world=world_label(args.world), start=(args.x, args.y, args.yaw), sim_time=end - start,
-        wall_time=data["wall"], distance=summary.distance_travelled(track[:, 1:3]),
+        wall_time=data["wall"], distance=metrics.distance_travelled(track[:, 1:3]),
         collisions=collisions,
         cases=summary.case_durations(recorder.cases, start, end), picture=paths["picture"],
         bag=paths["bag"] if args.bag else "", replay=replay)

@@ -17,13 +17,16 @@ The tool's own clean-up (a session shut down, processes stopped by PID) stays in
 import sys
 
 
+class Interrupted(Exception):
+    """Ctrl-C (SIGINT) or SIGTERM, raised in the main thread by
+    running.processes.raise_on_signals' handler; its text is the signal's name."""
+
+
 class BadInput(Exception):
     """The user's input cannot be used; the message names it and says what to do."""
 
 
 def exit_status(tool, body, interrupted="", known=(), bad_input=(), catch_all=False):
-    from .processes import Interrupted
-
     def say(text):
         sys.stderr.write("%s: %s\n" % (tool, text))
     try:

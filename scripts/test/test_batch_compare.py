@@ -2,7 +2,7 @@
 to compare batches of different scenarios."""
 import pytest
 
-from m2wr_tools import compare, results
+from m2wr_tools.batch import compare, results
 
 
 def run(run_id, x, distance, contacts=0, clearance=0.5, stuck=0.0, world="world02"):

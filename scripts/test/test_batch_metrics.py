@@ -1,11 +1,11 @@
-"""m2wr_tools.metrics: a batch run's figures from recorded data, and the task verdicts."""
+"""m2wr_tools.analysis.metrics: a batch run's figures from recorded data, and the task verdicts."""
 import math
 
 import numpy as np
 import pytest
 
-from m2wr_tools import metrics
-from m2wr_tools.metrics import Task
+from m2wr_tools.analysis import metrics
+from m2wr_tools.analysis.metrics import Task
 
 
 def straight_track(speed=0.5, duration=10.0, rate=20.0):
@@ -19,7 +19,7 @@ def test_clip_and_decimate():
     assert clipped[0, 0] == 0.0 and clipped[-1, 0] == pytest.approx(10.0)
     sampled = metrics.decimate(clipped, 0.5)
     assert np.allclose(np.diff(sampled[:, 0]), 0.5)
-    assert metrics.distance(sampled[:, 1:3]) == pytest.approx(5.0)
+    assert metrics.distance_travelled(sampled[:, 1:3]) == pytest.approx(5.0)
 
 
 def test_contact_events_and_time_in_contact():
@@ -79,3 +79,9 @@ def test_task_round_trip():
     task = Task(kind="goal", goal=(1.5, -2.0), tolerance=0.4)
     assert Task.from_dict(task.as_dict()) == task
     assert not math.isnan(task.tolerance)
+
+
+def test_distance_travelled_is_the_polyline_length():
+    assert metrics.distance_travelled([(0, 0), (3, 4), (3, 4), (3, 0)]) == pytest.approx(9.0)
+    assert metrics.distance_travelled([(1, 1)]) == 0.0
+    assert metrics.distance_travelled([]) == 0.0

@@ -1,10 +1,10 @@
-"""m2wr_tools.recorder.Recorder.restart: the batch's one recorder per rig forgets a run's
+"""m2wr_tools.running.recorder.Recorder.restart: the batch's one recorder per rig forgets a run's
 data before the next run (callbacks fed by hand, no master)."""
 import rospy
 from gazebo_msgs.msg import ContactsState, ContactState
 from nav_msgs.msg import Odometry
 
-from m2wr_tools.recorder import Recorder
+from m2wr_tools.running.recorder import Recorder
 
 
 def odom_at(t, x=0.0):

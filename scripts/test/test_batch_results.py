@@ -1,9 +1,9 @@
-"""m2wr_tools.results: results.json/results.csv round trip, the deterministic view, the
+"""m2wr_tools.batch.results: results.json/results.csv round trip, the deterministic view, the
 summary table."""
 import csv
 import json
 
-from m2wr_tools import results
+from m2wr_tools.batch import results
 
 
 def record(run_id, success, distance, reason="no contact", world="world02"):

@@ -1,12 +1,12 @@
-"""m2wr_tools.scenarios: combinations, stable run ids, and start poses in free space
+"""m2wr_tools.batch.scenarios: combinations, stable run ids, and start poses in free space
 (fixture outlines: a 10 m x 10 m square of walls with a round pillar in the middle)."""
 import math
 
 import pytest
 
-from m2wr_tools.metrics import Task
-from m2wr_tools.scene import Outline
-from m2wr_tools.scenarios import (Scenario, check_starts, combinations, grid_starts,
+from m2wr_tools.analysis.metrics import Task
+from m2wr_tools.analysis.scene import Outline
+from m2wr_tools.batch.scenarios import (Scenario, check_starts, combinations, grid_starts,
                                   is_free, obstacle_distance, random_starts)
 
 

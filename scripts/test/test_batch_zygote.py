@@ -1,4 +1,4 @@
-"""m2wr_tools.zygote: a forked child runs a script as `python SCRIPT ARGS` would (argv,
+"""m2wr_tools.running.zygote: a forked child runs a script as `python SCRIPT ARGS` would (argv,
 sys.path, environment, output to its log, exit status, signals), and commands it cannot run
 warm are recognised."""
 import os
@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from m2wr_tools import processes, zygote
+from m2wr_tools.running import processes, zygote
 
 SCRIPT = """#!/usr/bin/env python3
 import os, sys, time

@@ -1,11 +1,12 @@
-"""The command lines of demo.sh and bench.sh (m2wr_tools.demo, m2wr_tools.bench), and the
+"""The command lines of demo.sh and bench.sh (m2wr_tools.demo, m2wr_tools.bench.cli), and the
 session's error text."""
 import os
 
 import pytest
 
-from m2wr_tools import bench, bench_loop, demo
-from m2wr_tools.session import _problem_lines
+from m2wr_tools.bench import cli as bench, loop as bench_loop
+from m2wr_tools import demo
+from m2wr_tools.running.session import _problem_lines
 
 
 def test_demo_defaults_are_the_tutorials_episode_5():

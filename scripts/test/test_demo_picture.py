@@ -1,11 +1,11 @@
-"""m2wr_tools.picture: beam geometry, scale bar, and that a picture is written."""
+"""m2wr_tools.analysis.picture: beam geometry, scale bar, and that a picture is written."""
 import math
 
 import numpy as np
 import pytest
 
-from m2wr_tools import picture
-from m2wr_tools.scene import Outline
+from m2wr_tools.analysis import picture
+from m2wr_tools.analysis.scene import Outline
 
 
 def test_beams_go_from_the_sensor_to_each_finite_return():

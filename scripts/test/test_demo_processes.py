@@ -1,4 +1,5 @@
-"""m2wr_tools.processes: free port, stopping process groups by escalation, finding leftovers.
+"""m2wr_tools.running.processes: free port, stopping process groups by escalation, finding
+leftovers.
 The children here are `sleep` and `bash`, each in a session of its own, and are always
 stopped by the test that starts them."""
 import os
@@ -9,8 +10,8 @@ import uuid
 
 import pytest
 
-from m2wr_tools import processes
-from m2wr_tools.processes import Child
+from m2wr_tools.running import processes
+from m2wr_tools.running.processes import Child
 
 
 @pytest.fixture

@@ -1,11 +1,12 @@
-"""m2wr_tools.recorder: what the demo keeps from each topic (callbacks fed by hand, no master)."""
+"""m2wr_tools.running.recorder: what the demo keeps from each topic (callbacks fed by hand, no
+master)."""
 import rospy
 from gazebo_msgs.msg import ContactsState, ContactState
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 from sensor_msgs.msg import LaserScan
 
-from m2wr_tools.recorder import Recorder
+from m2wr_tools.running.recorder import Recorder
 
 
 def log(name, text, t):

@@ -1,4 +1,4 @@
-"""m2wr_tools.scene: obstacles cut at scan height, the robot's clearance and link poses, on a
+"""m2wr_tools.analysis.scene: obstacles cut at scan height, the robot's clearance and link poses, on a
 fixture world with obstacles at known places (scripts/test/fixtures/scene.world) and the
 project's own m2wr description."""
 import math
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import xacro
 
-from m2wr_tools import scene as scene_mod
-from m2wr_tools.scene import Scene, cut_convex, cut_cylinder
+from m2wr_tools.analysis import scene as scene_mod
+from m2wr_tools.analysis.scene import Scene, cut_convex, cut_cylinder
 from pybullet_gazebo.engine.transforms import Pose, rotation_matrix, quaternion_from_rpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))

@@ -1,10 +1,10 @@
-"""m2wr_tools.summary: the run summary's maths and text."""
+"""m2wr_tools.analysis.summary: the run summary's maths and text."""
 import math
 
 import pytest
 
-from m2wr_tools import summary
-from m2wr_tools.summary import Collision, RunSummary
+from m2wr_tools.analysis import summary
+from m2wr_tools.analysis.summary import Collision, RunSummary
 
 
 def test_case_lines_are_recognised():
@@ -37,12 +37,6 @@ def test_case_order_is_numeric_not_alphabetical():
     events = [(0.0, "case 10 - x"), (1.0, "case 2 - front"), (2.0, "unknown case")]
     assert list(summary.case_durations(events, 0.0, 3.0)) == ["case 2 - front", "case 10 - x",
                                                             "unknown case"]
-
-
-def test_distance_travelled_is_the_polyline_length():
-    assert summary.distance_travelled([(0, 0), (3, 4), (3, 4), (3, 0)]) == pytest.approx(9.0)
-    assert summary.distance_travelled([(1, 1)]) == 0.0
-    assert summary.distance_travelled([]) == 0.0
 
 
 def test_collisions_count_onsets_not_contact_messages():

@@ -1,9 +1,9 @@
-"""The command line of evaluate.sh (m2wr_tools.evaluate): defaults, options, bad input."""
+"""The command line of evaluate.sh (m2wr_tools.batch.evaluate): defaults, options, bad input."""
 import sys
 
 import pytest
 
-from m2wr_tools import evaluate
+from m2wr_tools.batch import evaluate
 
 
 def test_defaults_are_the_tutorials_program_in_world02():
@@ -93,7 +93,7 @@ def test_a_bad_world_or_controller_stops_before_any_run_with_its_name(argv, mess
 
 
 def test_a_script_that_is_not_executable_is_named_with_the_fix(tmp_path):
-    from m2wr_tools import commands
+    from m2wr_tools.running import commands
     package = tmp_path / "pkg"
     (package / "scripts").mkdir(parents=True)
     (package / "package.xml").write_text("<package format='2'><name>pkg</name>"

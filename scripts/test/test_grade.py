@@ -9,9 +9,9 @@ import time
 
 import pytest
 
-from m2wr_tools import gazebo_calls
-from m2wr_tools import processes
-from m2wr_tools.commands import check, package_dir
+from m2wr_tools.running import gazebo_calls
+from m2wr_tools.running import processes
+from m2wr_tools.running.commands import check, package_dir
 from m2wr_tools.grade import classroom, rules, sandbox, scoring
 from m2wr_tools.grade.report import svg
 from m2wr_tools.grade.spec import DEFAULT_SPEC, SpecError, load
@@ -230,7 +230,7 @@ def test_scores_ranks_and_the_gradebook_are_stable(tmp_path):
 
 
 def test_the_trajectory_picture_draws_obstacles_path_start_and_goal():
-    from m2wr_tools.scene import Outline
+    from m2wr_tools.analysis.scene import Outline
     outlines = [Outline(model="can", kind="circle", center=(1.0, 1.0), radius=0.5),
                 Outline(model="box", kind="polygon", points=((2, 2), (3, 2), (3, 3), (2, 3)))]
     record = {"x": 0.0, "y": 0.0, "success": True, "path": [[0, 0, 0], [1, 0.0, 0.5]]}

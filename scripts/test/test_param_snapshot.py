@@ -1,6 +1,6 @@
 """The batch runner puts the parameter server back after each run: what a run's launch file
 added is deleted, what it changed or deleted is set back (no ROS master: a dict stands in)."""
-from m2wr_tools.param_snapshot import ParamSnapshot, leaves
+from m2wr_tools.running.param_snapshot import ParamSnapshot, leaves
 
 
 class FakeServer:

@@ -2,7 +2,7 @@
 exit status a script can act on; never a traceback."""
 import pytest
 
-from m2wr_tools.processes import Interrupted
+from m2wr_tools.running.processes import Interrupted
 from m2wr_tools.tool_exit import BadInput, exit_status
 
 

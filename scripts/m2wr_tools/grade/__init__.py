@@ -1,6 +1,6 @@
 """The class grader (scripts/grade.sh): every student's motion_plan package graded on a
-spec's tasks by the batch runner (m2wr_tools.batch, m2wr_tools.rig), each run isolated and
-its rules enforced, and the results as a static site, a gradebook CSV and a JSON file.
+spec's tasks by the batch runner (m2wr_tools.batch.cluster, m2wr_tools.batch.rig), each run
+isolated and its rules enforced, and the results as a static site, a gradebook CSV and a JSON file.
 One job a module:
   spec       the YAML spec of the tasks (and spec_default.yaml, episodes 5-10)
   classroom  the class folder: a student's package or loose scripts; their overlay

@@ -18,7 +18,6 @@ the simulator's window shows it at real time.
 Exit status: 0 when the class was graded (failed runs and students included); 1 when it
 could not run; 2 for bad input; 130 when interrupted.
 """
-import argparse
 import os
 import sys
 
@@ -26,27 +25,31 @@ from ..paths import ROOT
 from . import classroom, scoring
 from .spec import DEFAULT_SPEC, SpecError, load
 from ..tool_exit import BadInput, exit_status
+from .. import usage
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="grade.sh", description=__doc__.split("\n\n")[0])
+    parser = usage.parser("scripts/grade.sh", __doc__, examples=[
+        "scripts/grade.sh ~/class                 # one folder per student; episodes 5-10",
+        "scripts/grade.sh ~/class --spec my_spec.yaml --output ~/grades --workers 2",
+        "scripts/grade.sh --replay alice ep10_bug2 0 --output ~/grades --gui   # one run again"])
     parser.add_argument("class_dir", nargs="?", metavar="CLASS_DIR",
                         help="a folder with one folder per student")
     parser.add_argument("--spec", default=DEFAULT_SPEC,
-                        help="the YAML spec of the tasks (default: episodes 5-10)")
+                        help="the YAML spec of the tasks (default: spec_default.yaml, episodes 5-10)")
     parser.add_argument("--output", default=os.path.join(ROOT, "output", "grade"),
-                        help="the report's folder (default output/grade)")
+                        help="the report's folder (default: output/grade)")
     parser.add_argument("--scheduler", help="address of a Dask scheduler, e.g. "
                         "tcp://127.0.0.1:8786 (default: a LocalCluster)")
-    parser.add_argument("--workers", type=int, help="LocalCluster workers (default: cores)")
+    parser.add_argument("--workers", type=int, help="LocalCluster workers (default: one per core)")
     parser.add_argument("--fresh", action="store_true", help="grade again from scratch")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--cold-start", action="store_true",
                         help="start Python controllers as new interpreters through prlimit, "
                              "not forked from a warm one (same limits and user either way)")
     parser.add_argument("--replay", nargs=3, metavar=("STUDENT", "TASK", "RUN"),
-                        help="run one graded run again and draw it")
-    parser.add_argument("--gui", action="store_true", help="--replay: show the simulator")
+                        help="run one graded run again, on this machine, and draw it")
+    parser.add_argument("--gui", action="store_true", help="with --replay: show the simulator's window, at real time")
     args = parser.parse_args(argv)
     if args.replay is None and args.class_dir is None:
         parser.error("pass CLASS_DIR (a folder with one folder per student), or --replay "

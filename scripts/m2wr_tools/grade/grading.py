@@ -4,7 +4,7 @@ student, and the records gathered per student and task.
 
 A run that cannot start is failed here with its reason and never sent to a worker: a
 submission with nothing to grade, a task whose world does not exist, a command whose package
-or script the student's folder lacks (m2wr_tools.commands, as rosrun/roslaunch would look in
+or script the student's folder lacks (m2wr_tools.running.commands, as rosrun/roslaunch would look in
 it). Every other student is graded all the same.
 
 Folders under the output: stage/<student>/ (the packages as graded; root-only when
@@ -14,9 +14,9 @@ import os
 import stat
 import sys
 
-from ..batch import run_batch
-from ..commands import check
-from ..metrics import Task
+from ..batch.cluster import run_batch
+from ..running.commands import check
+from ..analysis.metrics import Task
 from . import classroom, sandbox
 from .runner import GradedScenario, GradeOptions, grade_run
 from ..paths import ROOT

@@ -7,7 +7,7 @@ the simulator's window and runs at real time (lockstep still: the same physics).
 import json
 import os
 
-from .. import processes
+from ..running import processes
 from .runner import GradedScenario, GradeOptions, GradeRig
 
 COMPARED = (("success", "success", ""), ("reason", "reason", ""),

@@ -17,7 +17,7 @@ import json
 import math
 import os
 
-from ..processes import log_tail
+from ..running.processes import log_tail
 from . import replay_view, scoring
 
 STYLE = """body{font-family:sans-serif;margin:1.5em;color:#222}
@@ -47,7 +47,7 @@ def _page(title, body, up=""):
 
 def _outlines(world, cache={}):
     if world not in cache:
-        from ..scene import SCAN_HEIGHT, Scene
+        from ..analysis.scene import SCAN_HEIGHT, Scene
         try:
             scene = Scene.of_world(world)
         except Exception:           # a missing world: pictures without obstacles

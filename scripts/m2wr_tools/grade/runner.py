@@ -1,4 +1,4 @@
-"""One graded run on a Dask worker: the batch runner's rig (m2wr_tools.rig, same lockstep
+"""One graded run on a Dask worker: the batch runner's rig (m2wr_tools.batch.rig, same lockstep
 run, same metrics) with the student's packages resolved first, the run isolated
 (m2wr_tools.grade.sandbox) and the task's rules enforced (m2wr_tools.grade.rules).
 
@@ -36,9 +36,9 @@ from typing import Tuple
 
 import yaml
 
-from .. import gazebo_calls, processes, stale_nodes
-from ..rig import NODE, Rig, RunFailed, RunOptions, run_on
-from ..scenarios import Scenario
+from ..running import gazebo_calls, processes, stale_nodes
+from ..batch.rig import NODE, Rig, RunFailed, RunOptions, run_on
+from ..batch.scenarios import Scenario
 from . import classroom, launch_filter, rules, sandbox, scoring
 from .spec import Limits, Step
 
@@ -156,7 +156,7 @@ class GradeRig(Rig):
         argv = tuple(argv)
         if self.current is None or len(argv) < 3:
             return argv
-        from ..commands import find_in_package, package_dir
+        from ..running.commands import find_in_package, package_dir
         if argv[0] == "rosrun":
             folder = package_dir(argv[1], self.current.env(self))
             found = find_in_package(folder, argv[2], executable=True) if folder else []

@@ -12,7 +12,7 @@ is readable by others). Every process of the run:
     RLIMIT_NPROC (processes and threads of the user), RLIMIT_FSIZE (largest file) and no
     core dumps (`rlimits`), in a process group of its own: a Python script forked from the
     worker's warm zygote, which sets them and the user in the child before the script's
-    first line (m2wr_tools.zygote), anything else through `prlimit` (`limited`); what the
+    first line (m2wr_tools.running.zygote), anything else through `prlimit` (`limited`); what the
     child runs starts as the user either way;
   - is watched (Watchdog, every WATCH_PERIOD s): the resident memory of all the user's
     processes together over the limit ends them all at once (a fork-and-allocate loop
@@ -35,7 +35,7 @@ import subprocess
 import threading
 import time
 
-from .. import processes
+from ..running import processes
 
 SLOTS_DIR = "/tmp/m2wr-grade-slots"
 RUNS_DIR = "/tmp/m2wr-grade-runs"

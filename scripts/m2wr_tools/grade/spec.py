@@ -13,7 +13,7 @@ field (the default, spec_default.yaml beside this file, says the same in its com
     command     required  the command line, as a student would type it: `rosrun PKG SCRIPT`
                           or `roslaunch PKG FILE.launch ARG:=VALUE...`
     kind        required  wander | goal | wall: what the batch runner measures
-                          (m2wr_tools.metrics: wander = no contact and min_distance
+                          (m2wr_tools.analysis.metrics: wander = no contact and min_distance
                           travelled; goal = within tolerance of goal; wall = no contact and
                           half the time 0.2-1.5 m from an obstacle)
     episode               the series' episode number (shown in the report)
@@ -57,7 +57,7 @@ from typing import Optional, Tuple
 
 import yaml
 
-from ..metrics import TASKS
+from ..analysis.metrics import TASKS
 from .rules import PERMISSIONS
 
 DEFAULT_SPEC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "spec_default.yaml")

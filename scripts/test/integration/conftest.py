@@ -10,9 +10,9 @@ import types
 
 import pytest
 
-from m2wr_tools import processes
+from m2wr_tools.running import processes
 from m2wr_tools.paths import ROOT
-from m2wr_tools.scenarios import FREE_MARGIN, obstacle_distance
+from m2wr_tools.batch.scenarios import FREE_MARGIN, obstacle_distance
 
 EVALUATE = os.path.join(ROOT, "scripts", "evaluate.sh")
 FIXTURES = os.path.join(ROOT, "scripts", "test", "fixtures")

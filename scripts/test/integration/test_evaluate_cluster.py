@@ -5,8 +5,8 @@ gives every run, sane metrics, and the same metrics on both clusters, whichever 
 which run in which order."""
 import os
 
-from m2wr_tools import results
-from m2wr_tools.scene import SCAN_HEIGHT, Scene
+from m2wr_tools.batch import results
+from m2wr_tools.analysis.scene import SCAN_HEIGHT, Scene
 
 RUNS = 6
 ARGS = ["--random", str(RUNS), "--pose-seed", "3"]

@@ -10,7 +10,7 @@ import socket
 import subprocess
 import time
 
-from m2wr_tools.scene import SCAN_HEIGHT, Scene
+from m2wr_tools.analysis.scene import SCAN_HEIGHT, Scene
 
 RUNS = 6
 

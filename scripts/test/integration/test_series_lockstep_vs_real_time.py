@@ -2,7 +2,7 @@
 them (motion_plan/test/series_style: own rospy.Rate loops, bang-bang turns at 0.7 rad/s to a
 2 deg tolerance, no slow-down): the same start and goal give the same outcome in lockstep as
 at real time (reached or not, contact events), in a time within the spread of real-time runs,
-and two lockstep runs are identical. Each case runs `python -m m2wr_tools.series_runs` (its
+and two lockstep runs are identical. Each case runs `python -m m2wr_tools.bench.series_runs` (its
 own master, stopped by PID at its end).
 
 Real time varies from run to run: the moment a loop ticks against the drive's updates is left
@@ -32,10 +32,10 @@ GOALS = [(-3.0, 7.0), (6.0, 6.5), (-6.0, 6.0)]     # from (0, 8) in world02
 
 
 def series_runs(tmp_path, program, *args, timeout=900):
-    """The records of `python -m m2wr_tools.series_runs --program PROGRAM ARGS`."""
+    """The records of `python -m m2wr_tools.bench.series_runs --program PROGRAM ARGS`."""
     out = tmp_path / "records.json"
     done = subprocess.run(
-        [sys.executable, "-m", "m2wr_tools.series_runs", "--program", program,
+        [sys.executable, "-m", "m2wr_tools.bench.series_runs", "--program", program,
          "--output", str(tmp_path), "--json", str(out)] + [str(a) for a in args],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout,
         stdin=subprocess.DEVNULL)

@@ -7,7 +7,7 @@ import textwrap
 import time
 import xmlrpc.client
 
-from m2wr_tools.session import Session
+from m2wr_tools.running.session import Session
 
 NODE = "/stale_probe"
 # a rospy node that logs once (rospy then subscribes /rosout_disable_topics_generation, the

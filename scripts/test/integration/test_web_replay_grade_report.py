@@ -1,7 +1,7 @@
 """A grader's student page embeds each run's replay (the browser view), and the report opens
 from file:// in Debian's chromium (Playwright) with no network: the replay's page loads
 inside the student page with no console error and shows m2wr where the run's track ends.
-The run's replay is made as the batch runner makes it (m2wr_tools.replays.build on the
+The run's replay is made as the batch runner makes it (m2wr_tools.analysis.replays.build on the
 offline scene), from a track written here (m2wr along world02's north corridor), so no
 simulation runs."""
 import json
@@ -10,10 +10,11 @@ import re
 
 import pytest
 
-from m2wr_tools import paths, replays
+from m2wr_tools import paths
+from m2wr_tools.analysis import replays
 from m2wr_tools.grade import report
 from m2wr_tools.grade.spec import load
-from m2wr_tools.scene import Scene
+from m2wr_tools.analysis.scene import Scene
 
 CHROMIUM = "/usr/bin/chromium"
 FLAGS = ["--no-sandbox", "--headless", "--use-gl=angle", "--use-angle=swiftshader",

@@ -14,9 +14,9 @@ import time
 
 import pytest
 
-from m2wr_tools import processes
+from m2wr_tools.running import processes
 from m2wr_tools.paths import ROOT
-from m2wr_tools.session import Session
+from m2wr_tools.running.session import Session
 
 CHROMIUM = "/usr/bin/chromium"
 FLAGS = ["--no-sandbox", "--headless", "--use-gl=angle", "--use-angle=swiftshader",

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from m2wr_tools import processes, zygote
+from m2wr_tools.running import processes, zygote
 
 PROGRAM = """#!/usr/bin/env python3
 import rospy

@@ -3,9 +3,6 @@ ROS node motion_plan/learned_avoidance.py runs (see policy.py). Run through scri
 which installs the training extra (requirements-train.txt: torch CPU, stable-baselines3) on
 first use.
 
-    scripts/train.sh                                  # avoid, world02, PPO, 2 envs
-    scripts/train.sh --timesteps 20000 --out /tmp/x   # a quick try
-
 Prints progress every --report-every timesteps (episodes, mean return and length, env steps
 per second, time left); writes OUT/policy.npz, OUT/learning_curve.png, OUT/model.zip (the
 SB3 model, to go on training) and OUT/N.monitor.csv (one row per episode per environment).
@@ -25,12 +22,35 @@ import time
 import numpy as np
 
 
+EXAMPLES = """examples:
+  scripts/train.sh                                  # avoid, world02, PPO, 2 envs
+  scripts/train.sh --timesteps 20000 --out /tmp/x   # a quick try
+  scripts/train.sh --task goal --observation scan --downsample 8
+
+Exit status: 0 when the policy was written; 1 when training failed; 2 for bad arguments."""
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    """The tools' --help convention (scripts/m2wr_tools/usage.py, which this library may not
+    import): the text as written, `(default: X)` after each option's help."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "(default" in text or action.default is None or action.default is False \
+                or action.default is argparse.SUPPRESS:
+            return text
+        return super()._get_help_string(action)
+
+
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(prog="scripts/train.sh", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--task", default="avoid", choices=("avoid", "goal"))
+    p = argparse.ArgumentParser(prog="scripts/train.sh", description=__doc__.strip(),
+                                epilog=EXAMPLES, formatter_class=HelpFormatter)
+    p.add_argument("--task", default="avoid", choices=("avoid", "goal"),
+                   help="avoid: drive without touching anything (episode 5's task); goal: "
+                   "reach a goal drawn each episode")
     p.add_argument("--world", default="world02", help="world01, world02 or a .world path")
-    p.add_argument("--algo", default="ppo", choices=("ppo", "dqn"))
+    p.add_argument("--algo", default="ppo", choices=("ppo", "dqn"),
+                   help="stable-baselines3's algorithm")
     p.add_argument("--timesteps", type=int, default=300000, help="environment steps in all")
     p.add_argument("--envs", type=int, default=2, help="environments (1: in this process; "
                    "more: in workers, the first here when they fit the cores)")
@@ -39,14 +59,21 @@ def parse_args(argv=None):
                         "the first env in this process when the envs fit the cores), the same "
                         "with every env in a worker (on a machine busy with other programs), "
                         "or SB3's SubprocVecEnv")
-    p.add_argument("--observation", default="regions", choices=("regions", "scan"))
-    p.add_argument("--downsample", type=int, default=1)
+    p.add_argument("--observation", default="regions", choices=("regions", "scan"),
+                   help="regions: episode 4's five, as reading_laser.py computes them; scan: "
+                   "the 720 beams")
+    p.add_argument("--downsample", type=int, default=1,
+                   help="with --observation scan: the minimum of each group of this many "
+                   "beams (a divisor of 720)")
     p.add_argument("--episode-seconds", type=float, default=60.0,
                    help="sim time of a training episode [s]")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--hidden", type=int, nargs="+", default=[64, 64], help="MLP layer sizes")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the algorithm and of the episodes' start poses")
+    p.add_argument("--hidden", type=int, nargs="+", default=[64, 64],
+                   help="MLP layer sizes (default: 64 64)")
     p.add_argument("--out", default=os.path.join(os.environ.get("M2WR_ROOT", "."), "output",
-                                                 "train"), help="output folder")
+                                                 "train"),
+                   help="output folder (default: output/train)")
     p.add_argument("--report-every", type=int, default=10000, help="timesteps between lines")
     args = p.parse_args(argv)
     if args.timesteps < 1 or args.envs < 1:

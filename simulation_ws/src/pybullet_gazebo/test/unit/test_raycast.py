@@ -11,7 +11,7 @@ on roughly half the rays that hit a curved shape. The tests therefore check:
   two report hits on the same rays except rays that pass within that tolerance of it.
 
 The cost of a 720-beam scan, this caster against rayTestBatch over the same beams in world02,
-is a figure of scripts/bench.sh (m2wr_tools.bench_engine), not a test.
+is a figure of scripts/bench.sh (m2wr_tools.bench.engine), not a test.
 """
 import math
 

@@ -2,7 +2,8 @@
 process (the engine of the ROS simulator, in lockstep semantics: each controller answers
 every decision at the sim time it would in lockstep), through m2wr_gym's environment.
 
-    python -m m2wr_tools.gym_evaluate --policy FILE.npz --world world02 --runs 40 --seconds 120
+    python -m m2wr_tools.batch.gym_evaluate --policy FILE.npz --world world02 --runs 40 \
+        --seconds 120
 
 Start poses: `runs` free poses drawn from --start-seed by the environment's free-pose
 sampler (the same list for both controllers). The tutorial's program is loaded from
@@ -15,7 +16,6 @@ clearance [m] between m2wr's footprint and any obstacle's (m2wr_gym.geometry, fr
 file), time stuck [s] (1-s windows in which the robot moved less than 0.1 m).
 Prints progress per run and a Markdown table; --csv writes one row per run.
 """
-import argparse
 import csv
 import logging
 import os
@@ -28,8 +28,9 @@ from m2wr_gym import geometry, observation, resources
 from m2wr_gym.env import M2wrEnv
 from m2wr_gym.policy import PolicyFileError, load
 
-from . import tutorial_scripts
-from .tool_exit import exit_status
+from .. import tutorial_scripts
+from ..tool_exit import exit_status
+from .. import usage
 
 STUCK_WINDOW = 1.0          # [s]
 STUCK_DISTANCE = 0.1        # [m]
@@ -148,19 +149,32 @@ def print_table(paths):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--policy", default=os.path.join(resources.package_path("m2wr_gym"),
-                                                    "policies", "avoid_world02.npz"))
-    p.add_argument("--world", default="world02")
-    p.add_argument("--runs", type=int, default=40)
-    p.add_argument("--seconds", type=float, default=120.0)
-    p.add_argument("--start-seed", type=int, default=2026)
+    p = usage.parser("python -m m2wr_tools.batch.gym_evaluate", __doc__, examples=[
+        "python -m m2wr_tools.batch.gym_evaluate --world world02   # the shipped policy, 40 starts",
+        "python -m m2wr_tools.batch.gym_evaluate --policy /tmp/try/policy.npz --runs 10",
+        "python -m m2wr_tools.batch.gym_evaluate --only tutorial --csv oa.csv"],
+        exit_statuses="Exit status: 0 with the table printed; 2 for bad arguments or a policy "
+        "file that cannot be\nused; 130 when interrupted.")
+    p.add_argument("--policy", default=None,
+                   help="the policy file (.npz, as scripts/train.sh exports it) (default: "
+                   "m2wr_gym's shipped policies/avoid_world02.npz)")
+    p.add_argument("--world", default="world02", help="world01, world02 or a .world path")
+    p.add_argument("--runs", type=int, default=40,
+                   help="start poses, the same for both controllers")
+    p.add_argument("--seconds", type=float, default=120.0, help="sim time of a run [s]")
+    p.add_argument("--start-seed", type=int, default=2026,
+                   help="seed of the free start poses")
     p.add_argument("--only", choices=("policy", "tutorial"), default=None,
-                   help="run one controller only (write --csv, then --table the CSVs)")
-    p.add_argument("--csv", default="", help="write one row per run here")
+                   help="run one controller only (write --csv, then --table the CSVs) "
+                   "(default: both)")
+    p.add_argument("--csv", default="", help="write one row per run to this file "
+                   "(default: none)")
     p.add_argument("--table", nargs="+", default=None, metavar="CSV",
                    help="print the table of earlier runs' CSVs and stop")
     args = p.parse_args(argv)
+    if args.policy is None:
+        args.policy = os.path.join(resources.package_path("m2wr_gym"), "policies",
+                                   "avoid_world02.npz")
     if args.table:
         return print_table(args.table)
     poses = start_poses(args.world, args.runs, args.start_seed)

@@ -9,7 +9,7 @@ series' file names, with a bug2.launch). Like most classes, it hands in no bug 0
 those two tasks fail at once ("no launch file"), as they would for a real student.
 
 Overhead [s wall] is a run's wall time less the part in which the world ran (the record's
-overhead_s, see m2wr_tools.rig: resetting the world, starting and stopping the controller,
+overhead_s, see m2wr_tools.batch.rig: resetting the world, starting and stopping the controller,
 measuring) plus, for the grader, what it adds around the run (grader_s: the student's files
 copied in and out, the rules' last look, the end by PID). Medians: a worker's first run also
 starts its simulator. The comparison is like for like: the class graded again on the spec's
@@ -26,7 +26,6 @@ beside an ep5 run, which slowed its start by 10-30 ms and moved the ratio betwee
 
 Prints the figures and writes <output>/bench_grade.json.
 """
-import argparse
 import json
 import os
 import shutil
@@ -35,7 +34,8 @@ import subprocess
 import sys
 import time
 
-from .paths import ROOT
+from ..paths import ROOT
+from .. import usage
 
 SERIES_STYLE = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "test", "series_style")
 TUTORIAL = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "scripts",
@@ -81,7 +81,7 @@ DURATION = 60.0                  # [s sim] ... and its duration
 def write_one_task_spec(path, task):
     """The default spec with only `task` in it, written to `path`."""
     import yaml
-    from .grade.spec import DEFAULT_SPEC
+    from ..grade.spec import DEFAULT_SPEC
     with open(DEFAULT_SPEC) as source:
         spec = yaml.safe_load(source)
     spec["tasks"] = [t for t in spec["tasks"] if t["name"] == task]
@@ -177,7 +177,7 @@ def bench(args):
         # one seed (a new seed relaunches the simulator, as the class's runs never do),
         # starts drawn at random in the free space: as many runs as the class had students
         evaluate_out = os.path.join(output, "bench_grade_evaluate%s" % suffix)
-        _run([sys.executable, "-m", "m2wr_tools.evaluate", "--controller", TUTORIAL,
+        _run([sys.executable, "-m", "m2wr_tools.batch.evaluate", "--controller", TUTORIAL,
               "--task", "wander", "--world", "world02", "--duration", str(DURATION),
               "--seeds", "0", "--random", str(max(2, len(names))), "--pose-seed", str(index),
               "--output", evaluate_out, "--fresh", "--no-progress"] + workers,
@@ -226,13 +226,23 @@ def bench(args):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="bench_grade", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--students", type=int, default=30)
-    parser.add_argument("--workers", type=int, default=None, help="default: cores")
+    parser = usage.parser("scripts/bench.sh --grade", __doc__, examples=[
+        "scripts/bench.sh --grade                 # 30 students, one worker per core",
+        "scripts/bench.sh --grade --students 4 --rounds 1 --output /tmp/grade-bench"],
+        exit_statuses="Exit status: 0 when the figures were measured; 1 when the grader or "
+        "the batch runner failed\n(the step is named); 2 for bad arguments; 130 when "
+        "interrupted.")
+    parser.add_argument("--students", type=int, default=30,
+                        help="students in the class made for the benchmark")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="Dask workers of the grader and the batch runner "
+                        "(default: one per core)")
     parser.add_argument("--rounds", type=int, default=2,
                         help="rounds of the like-for-like comparison, grader and batch runner "
-                             "in turn (default 2); the ratio is of all rounds' runs")
-    parser.add_argument("--output", default=os.path.join(ROOT, "output"))
+                             "in turn; the ratio is of all rounds' runs")
+    parser.add_argument("--output", default=os.path.join(ROOT, "output"),
+                        help="folder for bench_grade.json, the class, its report and logs "
+                        "(default: output/)")
     args = parser.parse_args(argv)
     try:
         bench(args)

@@ -3,7 +3,7 @@
 turns, nothing tuned for this simulator), run in lockstep and at real time, with what a
 learner would see: reached or not, sim time to the goal, contact events, where it ended.
 
-    python -m m2wr_tools.series_runs --program go_to_point --goal -3 7 \\
+    python -m m2wr_tools.bench.series_runs --program go_to_point --goal -3 7 \\
         [--start 0 8 0] [--world world02] [--modes lockstep real-time] [--repeat 1]
         [--rate 20] [--duration 60] [--clock-hz 100] [--json PATH]
 
@@ -16,7 +16,6 @@ run starts (sim time now), physics unpauses, and /odom is watched until the robo
 goal or `duration` of sim time has passed. The same steps in both modes, so that the only
 difference is the pacing: lockstep (real_time_factor 0) or real time (real_time_factor 1).
 """
-import argparse
 import json
 import math
 import os
@@ -26,12 +25,13 @@ import time
 from dataclasses import asdict, dataclass, field
 from typing import Optional, Tuple
 
-from . import gazebo_calls
-from .gazebo import call_empty
-from .names import PAUSE_SERVICE, UNPAUSE_SERVICE, WORLD_PROPERTIES_SERVICE
-from .processes import raise_on_signals
-from .session import Session, SessionError
-from .tool_exit import exit_status
+from ..running import gazebo_calls
+from ..running.gazebo import call_empty
+from ..names import PAUSE_SERVICE, UNPAUSE_SERVICE, WORLD_PROPERTIES_SERVICE
+from ..running.processes import raise_on_signals
+from ..running.session import Session, SessionError
+from ..tool_exit import exit_status
+from .. import usage
 
 # program -> (launch file in motion_plan/test/series_style, the switch service the run calls
 # or None when the program switches its own behaviours, its nodes' connections to the
@@ -244,23 +244,41 @@ class SeriesSession:
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m m2wr_tools.series_runs",
-                                     description=__doc__.split("\n\n")[0])
-    parser.add_argument("--program", choices=sorted(PROGRAMS), default="go_to_point")
-    parser.add_argument("--goal", type=float, nargs=2, metavar=("X", "Y"))
+    parser = usage.parser("python -m m2wr_tools.bench.series_runs", __doc__, examples=[
+        "python -m m2wr_tools.bench.series_runs --program go_to_point --goal -3 7",
+        "python -m m2wr_tools.bench.series_runs --program bug2 --goal 7 0 --start 0 0 0 "
+        "--modes lockstep",
+        "python -m m2wr_tools.bench.series_runs --program follow_wall --duration 120 "
+        "--json walls.json"],
+        exit_statuses="Exit status: 0 when every run was made (reached or not: the lines "
+        "say); 1 when a run could not\nstart; 2 for bad arguments; 130 when interrupted.")
+    parser.add_argument("--program", choices=sorted(PROGRAMS), default="go_to_point",
+                        help="the series-style program to run (motion_plan's "
+                        "test/series_style/, launched by its series_<program>.launch)")
+    parser.add_argument("--goal", type=float, nargs=2, metavar=("X", "Y"),
+                        help="the goal [m], needed by go_to_point and bug2 (reached: within "
+                        "0.3 m)")
     parser.add_argument("--start", type=float, nargs=3, metavar=("X", "Y", "YAW"),
-                        default=(0.0, 8.0, 0.0))
-    parser.add_argument("--world", default="world02")
-    parser.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES))
-    parser.add_argument("--repeat", type=int, default=1)
-    parser.add_argument("--rate", type=float, default=20.0)
-    parser.add_argument("--duration", type=float, default=60.0)
-    parser.add_argument("--clock-hz", type=float, default=100.0)
+                        default=(0.0, 8.0, 0.0), help="m2wr's start pose [m m rad] "
+                        "(default: 0 8 0)")
+    parser.add_argument("--world", default="world02", help="world01, world02, world03 or a "
+                        ".world path")
+    parser.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES),
+                        help="the pacings to run, in this order (default: lockstep real-time)")
+    parser.add_argument("--repeat", type=int, default=1, help="runs of each mode")
+    parser.add_argument("--rate", type=float, default=20.0,
+                        help="the program's own loop rate [Hz], its launch file's rate:=")
+    parser.add_argument("--duration", type=float, default=60.0,
+                        help="sim time a run may take to reach the goal [s]")
+    parser.add_argument("--clock-hz", type=float, default=100.0,
+                        help="/clock rate [Hz of sim time]; 100 is the world launch's own")
     parser.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE",
-                        help="an argument of the program's launch file (e.g. d:=1.5)")
+                        help="an argument of the program's launch file (e.g. d:=1.5); "
+                        "repeatable")
     parser.add_argument("--output", default=os.path.join("output", "series_runs"),
-                        help="folder for the logs (default output/series_runs)")
-    parser.add_argument("--json", help="also write the runs' records to this file (a list)")
+                        help="folder for the logs")
+    parser.add_argument("--json", help="also write the runs' records to this file (a list) "
+                        "(default: none)")
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     if args.program != "follow_wall" and args.goal is None:
         parser.error("--goal X Y is needed for %s" % args.program)

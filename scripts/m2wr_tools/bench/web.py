@@ -2,8 +2,8 @@
 page costs the lockstep loop (target: at most 10 %, as for the rviz-like listeners).
 
 Each round measures the lockstep loop of the whole bench (world02, m2wr, obstacle_avoidance.py,
-real_time_factor 0; bench_loop.measure_loop) twice in turn: without the page, then with
-web:=true and N pages watching (m2wr_tools.web_watch: WebSockets that read and decode every
+real_time_factor 0; loop.measure_loop) twice in turn: without the page, then with
+web:=true and N pages watching (m2wr_tools.bench.web_watch: WebSockets that read and decode every
 frame as a browser does, without drawing; a browser's drawing is its own process's cost,
 whatever the simulator sends). Printed per round: x real time without and with, the ratio,
 the simulator's CPU per sim second, frames the pages got per wall second; and the median."""
@@ -14,9 +14,9 @@ import statistics
 import subprocess
 import sys
 
-from . import processes
-from .bench_loop import measure_loop, say
-from .benchmath import fmt
+from ..running import processes
+from .loop import measure_loop, say
+from .arithmetic import fmt
 
 
 def web_rounds(session, listener, args):
@@ -27,7 +27,7 @@ def web_rounds(session, listener, args):
                                args.seconds, args.check_seconds)
         port = processes.free_port()
         watcher = subprocess.Popen(
-            [sys.executable, "-m", "m2wr_tools.web_watch", "ws://127.0.0.1:%d/ws" % port,
+            [sys.executable, "-m", "m2wr_tools.bench.web_watch", "ws://127.0.0.1:%d/ws" % port,
              "--pages", str(args.pages)], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
             text=True, start_new_session=True)
         try:

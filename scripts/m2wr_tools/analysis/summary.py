@@ -9,8 +9,6 @@ import math
 import re
 from typing import Dict, List, Optional, Sequence, Tuple
 
-import numpy as np
-
 # obstacle_avoidance.py's state descriptions: "case 1 - nothing" .. "case 8 - ...", and
 # "unknown case" (it logs the regions dict on the line before, which is not a case)
 _CASE = re.compile(r"^(case \d+ - .+|unknown case)$")
@@ -53,14 +51,6 @@ def case_durations(events: Sequence[Tuple[float, str]], start: float, end: float
         if finish > begin:
             totals[case] = totals.get(case, 0.0) + (finish - begin)
     return {case: totals[case] for case in sorted(totals, key=_case_order)}
-
-
-def distance_travelled(xy) -> float:
-    """Length of the polyline through the (n, 2) positions [m]."""
-    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    if len(xy) < 2:
-        return 0.0
-    return float(np.hypot(*np.diff(xy, axis=0).T).sum())
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """Runs a batch of scenarios on Dask: an embedded LocalCluster (one single-threaded worker
 process per core, on 127.0.0.1, no dashboard) or an existing cluster's scheduler address.
 
-Each run is one Dask task, m2wr_tools.rig.run_scenario, whose result is a plain record; the
+Each run is one Dask task, m2wr_tools.batch.rig.run_scenario, whose result is a plain record; the
 records are written to <output>/results.json and results.csv as they arrive, so an
 interrupted batch resumes where it stopped (runs already in the results are skipped). A
 worker that dies has its runs rescheduled by Dask on the others (the scheduler's
@@ -20,8 +20,9 @@ import uuid
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
-from . import processes, results
-from .processes import Interrupted, raise_on_signals
+from ..running import processes
+from . import results
+from ..running.processes import Interrupted, raise_on_signals
 from .rig import BATCH_TAG, RunOptions, close_rig, options_dict, run_scenario
 
 

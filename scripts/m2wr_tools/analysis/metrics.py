@@ -78,8 +78,9 @@ def decimate(track, period):
     return track[keep]
 
 
-def distance(xy):
-    """Length of the polyline through the (n, 2) positions [m]."""
+def distance_travelled(xy) -> float:
+    """Length of the polyline through the (n, 2) positions [m]: the distance a run travelled
+    (the demo's summary, a batch run's record)."""
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     return float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) >= 2 else 0.0
 

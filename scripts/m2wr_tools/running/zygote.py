@@ -14,7 +14,7 @@ never calls rospy.init_node and runs no thread, so a child's node starts as a fr
 Python's `random` reseeds itself in every child; numpy's global generator is reseeded from
 the OS too. The one thing a child shares with its siblings is Python's string-hash seed.
 In a child, three of rospy's idle waits are shorter and its rospy.spin() tells the zygote
-when the program enters it (m2wr_tools.warm_rospy): the program's own behaviour is the same.
+when the program enters it (m2wr_tools.running.warm_rospy): the program's own behaviour is the same.
 
 Which commands can use it (`warm_script`): a `.py` script run by this interpreter, either
 given as `PYTHON SCRIPT ARGS` or as an executable script whose `#!` line names `python` or
@@ -110,7 +110,7 @@ class Zygote:
         env = dict(env, M2WR_ZYGOTE_FD=str(theirs.fileno()))
         try:
             self.process = processes.Child(
-                "zygote", [sys.executable, "-m", "m2wr_tools.zygote"], env, log_path,
+                "zygote", [sys.executable, "-m", "m2wr_tools.running.zygote"], env, log_path,
                 pass_fds=(theirs.fileno(),))
         finally:
             theirs.close()

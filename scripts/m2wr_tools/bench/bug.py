@@ -4,7 +4,7 @@ publishing from its own 20 Hz rospy.Rate loop) takes m2wr from (0, 8) to the goa
 at real_time_factor 0, as the bug2_*.test rostests run it.
 
   scripts/bench.sh --bug [--worlds world02 world03] [--output output/]
-  (or: python -m m2wr_tools.bench_bug ...)
+  (or: python -m m2wr_tools.bench.bug ...)
 
 Prints per world: sim time and wall time from the robot's placement to `goal reached`, their
 ratio (x real time), whether lockstep ever timed out (`no cmd_vel within` in the simulator's
@@ -14,7 +14,6 @@ machine is shared: compare figures only within one run). Writes <output>/bench_b
 The bench's own node does not use sim time (it never hears /clock): it reads sim times from
 the stamps of the controller's log lines, so it adds no wake-up per /clock.
 """
-import argparse
 import json
 import os
 import re
@@ -22,11 +21,12 @@ import sys
 import threading
 import time
 
-from . import processes
-from .processes import raise_on_signals
-from .names import CONTACTS_TOPIC, ROSOUT_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH
-from .session import Session, SessionError
-from .tool_exit import exit_status
+from ..running import processes
+from ..running.processes import raise_on_signals
+from ..names import CONTACTS_TOPIC, ROSOUT_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH
+from ..running.session import Session, SessionError
+from ..tool_exit import exit_status
+from .. import usage
 
 # world: (legacy_mode, the controllers' turn_sign, goal), as bug2_world02/03.test run them
 RUNS = {
@@ -194,13 +194,20 @@ def report(runs, load):
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="bench_bug", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--worlds", nargs="+", default=list(RUNS), choices=list(RUNS))
+    parser = usage.parser("scripts/bench.sh --bug", __doc__, examples=[
+        "scripts/bench.sh --bug                   # both worlds",
+        "scripts/bench.sh --bug --worlds world03 --output /tmp/bug"],
+        exit_statuses="Exit status: 0 when every run reached its goal; 1 when one did not or "
+        "could not run; 2 for\nbad arguments; 130 when interrupted.")
+    parser.add_argument("--worlds", nargs="+", default=list(RUNS), choices=list(RUNS),
+                        help="the worlds to run bug 2 in, each from its own start to its goal "
+                        "(default: %s)" % " ".join(RUNS))
     parser.add_argument("--sim-limit", type=float, default=DEFAULT_SIM_LIMIT,
-                        help="[s] of sim time a run may take (default %(default)s)")
+                        help="sim time a run may take [s]")
     parser.add_argument("--wall-limit", type=float, default=DEFAULT_WALL_LIMIT,
-                        help="[s] of wall time a run may take (default %(default)s)")
-    parser.add_argument("--output", default="output", help="folder for bench_bug.json and logs")
+                        help="wall time a run may take [s]")
+    parser.add_argument("--output", default="output",
+                        help="folder for bench_bug.json and logs")
     return parser.parse_args(argv)
 
 

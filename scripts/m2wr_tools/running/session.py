@@ -17,7 +17,7 @@ import uuid
 import xmlrpc.client
 
 from . import processes, stale_nodes
-from .names import (COMMAND_TOPIC, CONTROLLER_NODE, SCAN_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH,
+from ..names import (COMMAND_TOPIC, CONTROLLER_NODE, SCAN_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH,
                     SPAWN_NODE, SPAWN_SERVICE, TUTORIAL_CONTROLLER, WORLD_LAUNCH)
 
 

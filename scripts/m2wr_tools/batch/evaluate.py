@@ -9,7 +9,7 @@
   scripts/evaluate.sh --bench-memory [--bench-runs 200] [--duration 5]
 
 Runs every combination of world x start x seed (lockstep, headless, as fast as the machine
-allows; see m2wr_tools.rig for what one run does), then writes <output>/results.json and
+allows; see m2wr_tools.batch.rig for what one run does), then writes <output>/results.json and
 results.csv (one record a run: scenario, success and why, time to goal, distance, minimum
 clearance, contact events and time in contact, time stuck, path, final pose, wall time,
 real-time factor, the controller's exit status and log), prints the summary table, and draws
@@ -32,14 +32,13 @@ the workers and simulators over the runs (figures printed, not asserted).
 with reuse; prints the resident memory of the worker, its simulator and its controller
 zygote at runs 1, 50, 100, 150, 200 and the slope [MiB per 100 runs] after run 20.
 
-Python controllers are forked from a warm process (m2wr_tools.zygote: rospy already
+Python controllers are forked from a warm process (m2wr_tools.running.zygote: rospy already
 imported; the script itself still starts afresh each run); --cold-start starts them as
 plain processes.
 
 Exit status: 0 when the batch finished (failed runs included); 1 when it could not run;
 2 for bad arguments; 130 when interrupted.
 """
-import argparse
 import json
 import math
 import os
@@ -49,49 +48,54 @@ import sys
 import time
 
 from . import results
-from .metrics import TASKS, Task
-from .names import DEFAULT_START, DEFAULT_WORLD, TUTORIAL_CONTROLLER
-from .paths import ROOT
+from ..analysis.metrics import TASKS, Task
+from ..names import DEFAULT_START, DEFAULT_WORLD, TUTORIAL_CONTROLLER
+from ..paths import ROOT
 from .rig import RunOptions
 from .scenarios import FREE_MARGIN, check_starts, combinations, grid_starts, random_starts
-from .tool_exit import BadInput, exit_status
+from ..tool_exit import BadInput, exit_status
+from .. import usage
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="evaluate.sh", description=__doc__.split("\n\n")[0])
+    parser = usage.parser("scripts/evaluate.sh", __doc__, examples=[
+        "scripts/evaluate.sh --random 40 --duration 60    # obstacle_avoidance.py, 40 free starts",
+        "scripts/evaluate.sh --controller my_controller.py --grid 2 --seeds 0 1 --world world01",
+        "scripts/evaluate.sh --controller ~/go_to_point.py --task goal --goal 2 -3"])
     parser.add_argument("--controller", default=" ".join(TUTORIAL_CONTROLLER),
                         help="the controller: a command line (rosrun/roslaunch ...) or a path "
-                        "to a script (default: the tutorial's obstacle_avoidance.py)")
+                        "to a script")
     parser.add_argument("--task", choices=TASKS, default="wander",
                         help="wander: no contact and --min-distance travelled over the "
                         "duration; goal: reach --goal within --tolerance; wall: follow a wall")
     parser.add_argument("--goal", type=float, nargs=2, metavar=("X", "Y"),
                         help="goal [m] of the goal task (set as the des_pos_x/des_pos_y params)")
-    parser.add_argument("--tolerance", type=float, default=0.3, help="goal radius [m] (0.3)")
+    parser.add_argument("--tolerance", type=float, default=0.3, help="goal radius [m]")
     parser.add_argument("--min-distance", type=float, default=1.0,
-                        help="wander/wall: least distance [m] a successful run travels (1)")
+                        help="wander/wall: least distance [m] a successful run travels")
     parser.add_argument("--world", action="append", help="world01, world02 or a .world path "
-                        "(repeatable; default world02)")
+                        "(repeatable) (default: world02)")
     parser.add_argument("--start", type=float, nargs=3, action="append",
-                        metavar=("X", "Y", "YAW"), help="a start pose [m m rad] (repeatable)")
+                        metavar=("X", "Y", "YAW"), help="a start pose [m m rad] (repeatable) "
+                        "(default: the tutorial's 0 8 0)")
     parser.add_argument("--grid", type=float, metavar="STEP",
                         help="starts on a grid of STEP m over free space (heading 0)")
     parser.add_argument("--random", type=int, metavar="N", help="N random free start poses")
     parser.add_argument("--pose-seed", type=int, default=0,
-                        help="seed of the --random poses (default 0)")
+                        help="seed of the --random poses")
     parser.add_argument("--margin", type=float, default=FREE_MARGIN,
-                        help="free space: least distance [m] of a start from any obstacle "
-                        "(default %g)" % FREE_MARGIN)
+                        help="free space: least distance [m] of a start from any obstacle")
     parser.add_argument("--seeds", type=int, nargs="+", default=[0],
-                        help="simulator seeds (laser noise), one run each (default 0)")
+                        help="simulator seeds (laser noise), one run each (default: 0)")
     parser.add_argument("--duration", type=float, default=None,
-                        help="sim time of a run [s] (default 60; 5 with --bench-memory)")
-    parser.add_argument("--workers", type=int, help="LocalCluster workers (default: cores)")
+                        help="sim time of a run [s] (default: 60; 5 with --bench-memory)")
+    parser.add_argument("--workers", type=int, help="LocalCluster workers (default: one per core)")
     parser.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. "
                         "tcp://127.0.0.1:8786 (its workers need this project set up, "
-                        "scripts/env.sh sourced and --nthreads 1)")
+                        "scripts/env.sh sourced and --nthreads 1) (default: a LocalCluster on "
+                        "this machine)")
     parser.add_argument("--output", default=os.path.join(ROOT, "output", "evaluate"),
-                        help="folder of results, pictures and logs (default output/evaluate)")
+                        help="folder of results, pictures and logs (default: output/evaluate)")
     parser.add_argument("--no-reuse", action="store_true",
                         help="relaunch the simulator for every run")
     parser.add_argument("--bag", action="store_true", help="a rosbag per run in <output>/runs/")
@@ -103,15 +107,15 @@ def parse_args(argv):
     parser.add_argument("--fresh", action="store_true",
                         help="ignore the runs already in <output>/results.json")
     parser.add_argument("--connect-timeout", type=float, default=20.0,
-                        help="wall seconds for the controller to publish cmd_vel (20)")
+                        help="wall seconds for the controller to publish cmd_vel")
     parser.add_argument("--run-timeout", type=float, default=0.0,
-                        help="wall seconds a run may take (default 60 + 2 x duration)")
+                        help="wall seconds a run may take (default: 60 + 2 x duration)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    parser.add_argument("--bench", action="store_true", help="the batch benchmark (above)")
+    parser.add_argument("--bench", action="store_true", help="the batch benchmark (see above)")
     parser.add_argument("--bench-memory", action="store_true",
-                        help="the memory benchmark (above)")
+                        help="the memory benchmark (see above)")
     parser.add_argument("--bench-runs", type=int, default=None,
-                        help="runs of the benchmark (20; 200 with --bench-memory)")
+                        help="runs of the benchmark (default: 20; 200 with --bench-memory)")
     parser.add_argument("--cold-start", action="store_true",
                         help="start Python controllers as plain processes, not from the "
                         "warm zygote")
@@ -157,7 +161,7 @@ def controller_argv(text):
 def check_worlds(worlds):
     """ValueError naming the first world that has no world file, with the known ones."""
     from pybullet_gazebo.engine.sdf_world import WorldFileError
-    from .paths import world_path
+    from ..paths import world_path
     for world in worlds:
         try:
             world_path(world)
@@ -168,7 +172,7 @@ def check_worlds(worlds):
 
 def build_scenarios(args, outlines_of):
     """The batch's scenarios; ValueError naming a bad world, controller or start."""
-    from .commands import check
+    from ..running.commands import check
     check_worlds(args.world)
     controller = controller_argv(args.controller)
     check(controller, os.environ)
@@ -195,7 +199,7 @@ class _Outlines:
 
     def __call__(self, world):
         if world not in self.cache:
-            from .scene import SCAN_HEIGHT, Scene
+            from ..analysis.scene import SCAN_HEIGHT, Scene
             scene = Scene.of_world(world)
             try:
                 self.cache[world] = scene.outlines(SCAN_HEIGHT)
@@ -212,7 +216,7 @@ def report(args, records, outlines_of, scenarios):
     label = os.path.basename(scenarios[0].controller[-1]) if scenarios else ""
     print(results.summary_table(records, title="%s, task %s, %g s sim each" % (
         label, args.task, args.duration)), flush=True)
-    from . import batch_picture
+    from ..analysis import batch_picture
     pictures = []
     for world in args.world:
         label_world = scenarios[0].world_label if len(args.world) == 1 else \
@@ -245,7 +249,7 @@ def report(args, records, outlines_of, scenarios):
 
 def bench(args):
     """Runs/min for 1 and 2 workers with and without reuse on the same runs."""
-    from .batch import run_batch
+    from .cluster import run_batch
     outlines_of = _Outlines()
     args.world, args.random, args.start, args.grid = [DEFAULT_WORLD], args.bench_runs, None, None
     scenarios = build_scenarios(args, outlines_of)
@@ -369,7 +373,7 @@ def _cpu_medians(records):
 
 def bench_memory(args):
     """Resident memory of one worker, its simulator and zygote over many short runs."""
-    from .batch import run_batch
+    from .cluster import run_batch
     outlines_of = _Outlines()
     args.world, args.random, args.start, args.grid = [DEFAULT_WORLD], args.bench_runs, None, None
     scenarios = build_scenarios(args, outlines_of)
@@ -450,7 +454,7 @@ def main(argv=None):
 
 
 def evaluate(args):
-    from .batch import run_batch
+    from .cluster import run_batch
     os.makedirs(args.output, exist_ok=True)
     if args.bench:
         return bench(args)

@@ -30,8 +30,8 @@ from rosgraph_msgs.msg import Log
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
-from . import summary
-from .names import (CONTACTS_TOPIC, CONTROLLER_NODE, ODOM_TOPIC, ROSOUT_TOPIC, SCAN_TOPIC,
+from ..analysis import summary
+from ..names import (CONTACTS_TOPIC, CONTROLLER_NODE, ODOM_TOPIC, ROSOUT_TOPIC, SCAN_TOPIC,
                     TF_TOPIC)
 
 

@@ -1,7 +1,7 @@
 """Side by side: the batches of several controllers over the same scenarios, as a Markdown
 table (the README's comparison of the learned policy with obstacle_avoidance.py).
 
-    python -m m2wr_tools.compare "learned=output/cmp/learned_world02" \
+    python -m m2wr_tools.batch.compare "learned=output/cmp/learned_world02" \
                                  "obstacle_avoidance.py=output/cmp/oa_world02"
 
 Each LABEL=FOLDER is a batch folder of scripts/evaluate.sh (its results.json). The batches
@@ -11,11 +11,11 @@ Columns: runs without contact, median and mean distance [m], median and worst mi
 clearance [m], median time stuck [s], runs that failed for another reason (controller
 crash, timeout).
 """
-import argparse
 import statistics
 import sys
 
 from . import results
+from .. import usage
 
 HEADER = ("| controller | runs without contact | median distance [m] | mean distance [m] | "
           "median min. clearance [m] | worst min. clearance [m] | median time stuck [s] | "
@@ -67,8 +67,14 @@ def table(batches):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("batches", nargs="+", metavar="LABEL=FOLDER")
+    parser = usage.parser("python -m m2wr_tools.batch.compare", __doc__, examples=[
+        'python -m m2wr_tools.batch.compare "learned=output/cmp/learned_world02" \\',
+        '    "obstacle_avoidance.py=output/cmp/oa_world02"'],
+        exit_statuses="Exit status: 0 with the table printed; 2 for bad arguments or "
+        "batches that cannot be compared.")
+    parser.add_argument("batches", nargs="+", metavar="LABEL=FOLDER",
+                        help="a label for the table's row and a scripts/evaluate.sh output "
+                        "folder (its results.json)")
     args = parser.parse_args(argv)
     pairs = []
     for item in args.batches:

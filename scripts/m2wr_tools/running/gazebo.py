@@ -1,6 +1,6 @@
 """The tools' calls to the simulator's Gazebo services (a rospy node must be initialised):
 pause/unpause/reset (std_srvs/Empty), every model's pose, and placing a model."""
-from .names import GET_MODEL_STATE_SERVICE, SET_MODEL_STATE_SERVICE, WORLD_PROPERTIES_SERVICE
+from ..names import GET_MODEL_STATE_SERVICE, SET_MODEL_STATE_SERVICE, WORLD_PROPERTIES_SERVICE
 
 
 def call_empty(name, timeout=10.0):

@@ -9,20 +9,20 @@ depends only on its scenario:
   generator re-seeded, the drive's command and lockstep's awaited answer forgotten) ->
   /gazebo/set_model_state m2wr at the start (z 0.5 m, at rest, as spawn.launch drops it) ->
   the recorder restarted (one per rig: its connections stay up) -> the controller started
-  (a Python script is forked from the session's warm zygote, m2wr_tools.zygote; anything
+  (a Python script is forked from the session's warm zygote, m2wr_tools.running.zygote; anything
   else is a plain process) and publishing cmd_vel -> if a command already reached the
   simulator, /gazebo/reset_world and m2wr put back where it stood (the drive forgets a
   command sent as the controller started, which reached it or not as the connection came
   up: every run starts alike) -> physics unpaused for `duration` s of sim time -> paused ->
   the controller sent SIGINT while the run is measured (the record's controller_stop says
-  so; a zygote's rospy program ends ~0.1 s later, m2wr_tools.warm_rospy) -> its exit
+  so; a zygote's rospy program ends ~0.1 s later, m2wr_tools.running.warm_rospy) -> its exit
   awaited (the next run's reset comes after it: none of its commands can reach
   that run).
 
 Per-run `stages` [s wall] in the record: reset_s, controller_start_s, sim_s, measure_s,
 stop_s; `overhead_s` = the run's wall time less sim_s's unpaused part; `cpu_s`: the CPU [s]
 of each process of the worker (this one, the simulator, its roslaunch, the master, the
-controller) per stage and in total (m2wr_tools.cpu_meter).
+controller) per stage and in total (m2wr_tools.running.cpu_meter).
 
 The simulator is kept between runs of the same world and seed (reuse) and relaunched
 otherwise (the seed is a launch argument), or before every run with reuse off. The world and
@@ -56,15 +56,16 @@ import xmlrpc.client
 
 import numpy as np
 
-from . import metrics, processes, stale_nodes
-from .gazebo import Services, model_poses
-from .names import (BASE_FRAME, COMMAND_TOPIC, CONTACTS_TOPIC, ODOM_TOPIC, PAUSE_SERVICE,
+from ..analysis import metrics
+from ..running import processes, stale_nodes
+from ..running.gazebo import Services, model_poses
+from ..names import (BASE_FRAME, COMMAND_TOPIC, CONTACTS_TOPIC, ODOM_TOPIC, PAUSE_SERVICE,
                     RESET_SIMULATION_SERVICE, RESET_WORLD_SERVICE, ROBOT,
                     ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC, SIMULATOR_NODE, TF_TOPIC,
                     UNPAUSE_SERVICE)
-from .param_snapshot import ParamSnapshot
+from ..running.param_snapshot import ParamSnapshot
 from .scenarios import Scenario
-from .session import Session, SessionError, python_logging_config
+from ..running.session import Session, SessionError, python_logging_config
 
 NODE = "/m2wr_batch"
 SPAWN_Z = 0.5                 # [m] spawn.launch's default drop height of link_chassis
@@ -90,7 +91,7 @@ class RunOptions:
     picture: bool = False             # the demo's picture per run: runs/<run_id>.png
     replay: bool = False              # the run's replay (browser view): runs/<run_id>.replay.json
     batch: str = ""                   # the batch's tag (BATCH_TAG in every child's environment)
-    warm_start: bool = True           # fork Python controllers from a warm zygote (m2wr_tools.zygote)
+    warm_start: bool = True           # fork Python controllers from a warm zygote (running.zygote)
     gui: bool = False                 # the simulator's window (replays); headless by default
     real_time_factor: float = 0.0     # sim s per wall s; 0 = as fast as the machine allows
 
@@ -215,7 +216,7 @@ class Rig:
     def _scene(self, world):
         if world not in self.scenes:
             import rospy
-            from .scene import Scene
+            from ..analysis.scene import Scene
             self.scenes[world] = Scene.of_world(world, rospy.get_param(ROBOT_DESCRIPTION_PARAM))
         return self.scenes[world]
 
@@ -316,11 +317,11 @@ class Rig:
         return report.get("controller", known_exit)
 
     def _cpu_meter(self):
-        """CPU of the run's processes (see m2wr_tools.cpu_meter): this worker (with the
+        """CPU of the run's processes (see m2wr_tools.running.cpu_meter): this worker (with the
         children it reaped: controllers started as plain processes), the simulator node, its
         roslaunch, the master, the controller while it runs, and the zygote with the
         controllers it has reaped (their whole CPU, their exit included)."""
-        from .cpu_meter import CpuMeter
+        from ..running.cpu_meter import CpuMeter
 
         def child(name):
             def pid():
@@ -338,7 +339,7 @@ class Rig:
 
     def _run(self, scenario, options, log_path, runs_dir, meter):
         import rospy
-        from .recorder import Recorder
+        from ..running.recorder import Recorder
         session = self.session
         stages, mark = {}, [time.monotonic()]
 
@@ -445,7 +446,7 @@ class Rig:
 
     def _start_controller(self, argv, log_path, warm):
         """The run's controller as the session's child "controller": forked from the warm
-        zygote when it is a Python script of this interpreter (see m2wr_tools.zygote), else
+        zygote when it is a Python script of this interpreter (see m2wr_tools.running.zygote), else
         a plain subprocess (roslaunch, binaries, other interpreters)."""
         session = self.session
         return self._start_warm_or_plain(
@@ -457,7 +458,7 @@ class Rig:
         `argv` is a Python script of this interpreter, with `confine` (zygote.Zygote.start's
         cwd, user, group, rlimits) set in the child before the script's first line; else,
         or when the zygote fails (a new one comes next run), `plain()`'s child."""
-        from . import zygote
+        from ..running import zygote
         child = None
         if warm and zygote.warm_script(argv, env.get("PATH", os.defpath)):
             try:
@@ -471,8 +472,8 @@ class Rig:
         return child
 
     def _zygote(self):
-        """The worker's warm zygote (m2wr_tools.zygote), started anew if it is not running."""
-        from . import zygote
+        """The worker's warm zygote (running.zygote), started anew if it is not running."""
+        from ..running import zygote
         if self.zygote is None or not self.zygote.running():
             if self.zygote is not None:
                 self.zygote.close()
@@ -496,7 +497,7 @@ class Rig:
         for `idle` [s] during which the controller used no CPU at all, when that node is
         the controller's own process (it has finished starting and waits for messages) -
         or at once when the controller, forked from the zygote, has entered rospy.spin()
-        (its main thread has made every subscription: m2wr_tools.warm_rospy)."""
+        (its main thread has made every subscription: m2wr_tools.running.warm_rospy)."""
         master = self.session.master()
         deadline = time.monotonic() + timeout
         ready_since, last = None, None
@@ -583,7 +584,7 @@ class Rig:
             distances = np.array([c.distance for c in clearances])
             nearest = clearances[int(np.argmin(distances))] if len(clearances) else None
             wall_share = metrics.fraction_within(distances, task.wall_near, task.wall_far)
-        distance = metrics.distance(track[:, 1:3])
+        distance = metrics.distance_travelled(track[:, 1:3])
         success, reason = metrics.judge(task, distance, events, goal_time, wall_share)
         path = metrics.decimate(track, PATH_PERIOD)
         result = {
@@ -610,7 +611,7 @@ class Rig:
     def _replay(self, scenario, track, scene, runs_dir):
         import json
         import rospy
-        from . import replays
+        from ..analysis import replays
         path = os.path.join(runs_dir, scenario.run_id + ".replay.json")
         rows = np.concatenate([track[:, :3], track[:, 4:9]], axis=1)   # t x y z q (no yaw)
         replay = replays.build(scene, rospy.get_param(ROBOT_DESCRIPTION_PARAM), rows,
@@ -623,8 +624,8 @@ class Rig:
         return path
 
     def _picture(self, scenario, track, scene, runs_dir):
-        from . import picture
-        from .scene import SCAN_HEIGHT
+        from ..analysis import picture
+        from ..analysis.scene import SCAN_HEIGHT
         path = os.path.join(runs_dir, scenario.run_id + ".png")
         picture.draw(path, scene.outlines(SCAN_HEIGHT), track[:, 0], track[:, 1], track[:, 2],
                      track[:, 3], title="%s: %s from (%.2f, %.2f), yaw %.0f deg, seed %d" % (
@@ -660,7 +661,7 @@ class Rig:
 def _case_shares(log_path, duration):
     """{case: sim seconds} of obstacle_avoidance.py's case lines in the controller's log
     (rospy prints each with its sim time), {} for a controller that prints none."""
-    from .summary import case_durations, case_lines
+    from ..analysis.summary import case_durations, case_lines
     try:
         with open(log_path, encoding="utf-8", errors="replace") as log:
             return case_durations(case_lines(log.read()), 0.0, duration)

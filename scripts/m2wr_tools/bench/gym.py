@@ -1,5 +1,5 @@
 """Speed figures of m2wr_gym's environments (printed, never asserted):
-`python -m m2wr_tools.gym_bench`.
+`python -m m2wr_tools.bench.gym`.
 
 1. One in-process environment (world02, 10 Hz control, 720-beam scan, random continuous
    actions drawn before the timing, the same three episodes from random free starts in
@@ -36,7 +36,6 @@ same-round ratios (with their range). The in-process figures are also given per
 second of this process's CPU time, which other programs on a shared machine disturb less
 than wall time (but still: note the load, `uptime`, with any figure).
 """
-import argparse
 import contextlib
 import multiprocessing
 import time
@@ -48,7 +47,8 @@ from gymnasium.vector import AsyncVectorEnv
 from m2wr_gym import actions
 from m2wr_gym.shared_vector import SharedMemoryVectorEnv, children_ignore_ctrl_c
 
-from .processes import cpu_seconds
+from ..running.processes import cpu_seconds
+from .. import usage
 
 KWARGS = dict(world="world02", start="random", observation="scan", action="continuous",
               control_rate=10.0, max_episode_seconds=120.0, end_on_contact=False)
@@ -590,11 +590,17 @@ def print_vector_summary(rounds, steps):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--rounds", type=int, default=3)
+    p = usage.parser("python -m m2wr_tools.bench.gym", __doc__, examples=[
+        "python -m m2wr_tools.bench.gym                 # both halves",
+        "python -m m2wr_tools.bench.gym --part env --rounds 5 --steps 1200"],
+        exit_statuses="Exit status: 0 with the figures printed; 2 for bad arguments; 130 when "
+        "interrupted.")
+    p.add_argument("--rounds", type=int, default=3,
+                   help="rounds of every measurement, the sides in turn")
     p.add_argument("--steps", type=int, default=600, help="env steps per measurement")
     p.add_argument("--part", choices=("all", "env", "vector"), default="all",
-                   help="env: the in-process figures (1, 3); vector: the subprocess ones (2)")
+                   help="env: the in-process figures (1, 3); vector: the subprocess ones (2); "
+                   "all: both")
     p.add_argument("--no-sb3", action="store_true",
                    help="leave out SB3's SubprocVecEnv (measured when stable-baselines3 is "
                         "installed: scripts/train.sh installs it)")

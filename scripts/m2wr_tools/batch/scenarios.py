@@ -14,7 +14,7 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from .metrics import Task
+from ..analysis.metrics import Task
 
 FREE_MARGIN = 0.6        # [m] m2wr's chassis and wheels reach ~0.3 m from its centre, plus room
 

@@ -14,7 +14,7 @@ Figures:
                     touched a model (free-running, the controller's answers come late in sim
                     time and the robot hits barriers: the reason lockstep exists)
   loop program      the same lockstep loop with obstacle_avoidance.py's rules driven by a
-                    rospy.Rate(20) loop of their own (m2wr_tools/loop_avoidance.py), at the
+                    rospy.Rate(20) loop of their own (m2wr_tools/bench/loop_avoidance.py), at the
                     demo's /clock rate (the batch runner's) and at the simulator's default
                     100 Hz (the world launch's): its x real time over obstacle_avoidance.py's
                     at the same clock (target >= 0.9)
@@ -55,7 +55,7 @@ Figures:
                     the controller and each listener (the most robust figure on a shared
                     machine: compare the listeners' CPU between builds)
   --web-only        the lockstep loop without and with the live web page (web:=true) and
-                    --pages pages watching it, ROUNDS times in turn (m2wr_tools.bench_web)
+                    --pages pages watching it, ROUNDS times in turn (m2wr_tools.bench.web)
 The machine is shared: the load average before and after is recorded with the figures.
 
 Where the simulator's time goes (profile recipe): run the loop (scripts/demo.sh, or
@@ -75,7 +75,6 @@ clock_topic.py) that line was 24 % of the main thread, half of it /clock to the 
 `-f raw` writes one line per stack: grep the main thread's (they start with "<module>
 (gazebo_world") and sum by function.
 """
-import argparse
 import json
 import math
 import os
@@ -83,16 +82,17 @@ import platform
 import statistics
 import sys
 
-from . import benchmath
-from .processes import raise_on_signals
-from .bench_engine import engine_figures
-from .bench_loop import (BUSY_PROGRAM, LOOP_PROGRAM, WORLD, START, Listener, launch_to_first_scan,
+from . import arithmetic
+from ..running.processes import raise_on_signals
+from .engine import engine_figures
+from .loop import (BUSY_PROGRAM, LOOP_PROGRAM, WORLD, START, Listener, launch_to_first_scan,
                          measure_loop,
                          say, soak)
-from .benchmath import fmt
-from .paths import ROOT
-from .session import Session, SessionError
-from .tool_exit import exit_status
+from .arithmetic import fmt
+from ..paths import ROOT
+from ..running.session import Session, SessionError
+from ..tool_exit import exit_status
+from .. import usage
 
 SIMULATOR_DEFAULT_CLOCK_HZ = 100.0
 UNLIMITED = "listeners, watch_rate 0"
@@ -126,7 +126,7 @@ def report(figures):
     lines = ["", "m2wr stand-in benchmark (%s, %d cores, load %s before, %s after)" % (
         WORLD, figures["machine"]["cores"], figures["machine"]["load_before"],
         figures["machine"]["load_after"]),
-        benchmath.table(names, [(label, *cells) for label, cells in rows])]
+        arithmetic.table(names, [(label, *cells) for label, cells in rows])]
     engine = figures["engine"]
     lines += [
         "",
@@ -312,36 +312,44 @@ def rounds_report(figures):
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="bench.sh", description=__doc__.split("\n\n")[0])
+    parser = usage.parser("scripts/bench.sh", __doc__, examples=[
+        "scripts/bench.sh                         # every figure of episode 5",
+        "scripts/bench.sh --loop-program-only 5   # the loop program's ratio, 5 rounds",
+        "scripts/bench.sh --bug --help            # the series' bug-2 runs: their own options",
+        "scripts/bench.sh --grade --help          # a class graded: its own options"],
+        exit_statuses="Exit status: 0 when the figures were measured (targets are printed, "
+        "not asserted); 1 when a\nrun could not start; 2 for bad arguments; 130 when "
+        "interrupted.")
     parser.add_argument("--seconds", type=float, default=15.0,
-                        help="wall seconds of each real-time-factor measurement (default 15)")
+                        help="wall seconds of each real-time-factor measurement (default: 15)")
     parser.add_argument("--check-seconds", type=float, default=5.0,
-                        help="wall seconds of each scan/answer count (default 5)")
+                        help="wall seconds of each scan/answer count (default: 5)")
     parser.add_argument("--clock-hz", type=float, default=20.0,
-                        help="/clock rate the demo uses [Hz sim] (default 20)")
+                        help="/clock rate the demo uses [Hz sim] (default: 20)")
     parser.add_argument("--soak", type=float, default=0.0, metavar="MINUTES",
                         help="also run a soak of MINUTES of wall time (default: none)")
     parser.add_argument("--listeners-only", type=int, default=0, metavar="ROUNDS",
                         help="only the lockstep loop without and with listeners, ROUNDS times "
                              "in turn (the listener target's ratio per round and its median); "
-                             "no engine, free-running or launch figures")
+                             "no engine, free-running or launch figures (default: off)")
     parser.add_argument("--loop-program-only", type=int, nargs="?", const=3, default=0,
                         metavar="ROUNDS",
                         help="only obstacle_avoidance.py, the loop program and "
                              "obstacle_avoidance.py beside a busy loop in lockstep, in turn, "
-                             "ROUNDS times (default 3) at --clock-hz and at 100 Hz: each "
-                             "round's ratios and their medians (targets >= 0.9 and >= 0.8)")
+                             "ROUNDS times (3 when ROUNDS is left out) at --clock-hz and at 100 Hz: "
+                             "each round's ratios and their medians (targets >= 0.9 and >= 0.8) "
+                             "(default: off)")
     parser.add_argument("--web-only", type=int, default=0, metavar="ROUNDS",
                         help="only the lockstep loop without and with the live web page watched "
                              "by --pages pages, ROUNDS times in turn (ratio per round, median; "
-                             "target >= 90 %%)")
+                             "target >= 90 %%) (default: off)")
     parser.add_argument("--pages", type=int, default=1,
-                        help="with --web-only: pages watching at once (default 1)")
+                        help="with --web-only: pages watching at once (default: 1)")
     parser.add_argument("--watch-rate", type=float, default=None, metavar="HZ",
                         help="with --listeners-only: the simulator's ~watch_rate (default: its "
                              "own, 30)")
     parser.add_argument("--output", default=os.path.join(ROOT, "output"),
-                        help="folder for bench.json and logs (default output/)")
+                        help="folder for bench.json and logs (default: output/)")
     args = parser.parse_args(argv)
     for name in ("seconds", "check_seconds", "clock_hz"):
         if not (math.isfinite(getattr(args, name)) and getattr(args, name) > 0):
@@ -393,7 +401,7 @@ def main(argv=None):
         rospy_hooks.watch_only()
         listener = Listener()
         if args.web_only:
-            from .bench_web import web_rounds
+            from .web import web_rounds
             figures["web_rounds"] = web_rounds(session, listener, args)
         elif args.listeners_only:
             figures["listener_rounds"] = listener_rounds(session, listener, args)
@@ -415,7 +423,7 @@ def main(argv=None):
     if figures.get("listener_rounds"):
         print(rounds_report(figures), flush=True)
     if figures.get("web_rounds"):
-        from .bench_web import web_report
+        from .web import web_report
         print(web_report(figures), flush=True)
     if "engine" in figures:
         print(report(figures) if figures["loop"] else "", flush=True)

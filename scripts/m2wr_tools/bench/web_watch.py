@@ -1,12 +1,11 @@
 """A stand-in for browser pages watching the live view (web:=true), for the bench:
 
-  python -m m2wr_tools.web_watch URL [--pages N]
+  python -m m2wr_tools.bench.web_watch URL [--pages N]
 
-opens N WebSockets to URL (ws://127.0.0.1:PORT/ws), trying again every 0.2 s until the
+It opens N WebSockets to URL (ws://127.0.0.1:PORT/ws), trying again every 0.2 s until the
 simulator serves them, and reads every message as a page does (JSON-decoded); on SIGTERM or
 SIGINT prints one JSON line {"pages", "frames", "bytes", "seconds"} and ends. No drawing:
 what it costs is what the simulator's server and the wire cost, plus decoding."""
-import argparse
 import asyncio
 import json
 import signal
@@ -14,6 +13,8 @@ import sys
 import time
 
 import aiohttp
+
+from .. import usage
 
 
 async def _page(url, counts, stop):
@@ -52,9 +53,10 @@ async def _main(args):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m m2wr_tools.web_watch",
-                                     description=__doc__.split("\n\n")[0],
-                                     formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    parser = usage.parser("python -m m2wr_tools.bench.web_watch", __doc__, examples=[
+        "python -m m2wr_tools.bench.web_watch ws://127.0.0.1:8090/ws --pages 3"],
+        exit_statuses="Exit status: 0 after SIGTERM or SIGINT, the counts printed; 2 for bad "
+        "arguments.")
     parser.add_argument("url", help="the live view's WebSocket, ws://127.0.0.1:PORT/ws")
     parser.add_argument("--pages", type=int, default=1, help="pages watching at once")
     args = parser.parse_args(argv)

@@ -1,4 +1,4 @@
-"""rospy's idle waits, shortened in the zygote's children (m2wr_tools.zygote), and a signal
+"""rospy's idle waits, shortened in the zygote's children (m2wr_tools.running.zygote), and a signal
 to the batch runner when the program has set up its node.
 
 A controller's program stays the user's, unmodified, and so does what its node does; only

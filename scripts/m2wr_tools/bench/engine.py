@@ -6,7 +6,7 @@ import time
 
 import numpy as np
 
-from .names import DEFAULT_START, DEFAULT_WORLD, ROBOT
+from ..names import DEFAULT_START, DEFAULT_WORLD, ROBOT
 
 WORLD, START = DEFAULT_WORLD, DEFAULT_START
 def engine_figures(steps=2000, scans=300):
@@ -18,7 +18,7 @@ def engine_figures(steps=2000, scans=300):
     from pybullet_gazebo.engine.sdf_world import load_world
     from pybullet_gazebo.engine.transforms import Pose
     from pybullet_gazebo.engine.world import World
-    from . import paths
+    from .. import paths
 
     spec = load_world(paths.world_path(WORLD), paths.model_path())
     urdf = paths.robot_urdf()

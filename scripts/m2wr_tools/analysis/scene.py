@@ -28,7 +28,7 @@ from pybullet_gazebo.engine.sdf_world import load_world
 from pybullet_gazebo.engine.transforms import Pose, rotation_matrix
 from pybullet_gazebo.engine.world import World
 
-from .names import ROBOT
+from ..names import ROBOT
 
 SCAN_HEIGHT = 0.15           # [m] m2wr's laser plane above the ground, where obstacles are cut
 _PRISM_SIDES = 48            # a tilted cylinder is cut as this many-sided prism
@@ -122,7 +122,7 @@ class Scene:
     def of_world(cls, world, urdf_xml=None):
         """The scene of `world` (world01, world02 or a .world path) with m2wr (the URDF
         xacro makes from m2wr_description, unless `urdf_xml` is given)."""
-        from . import paths
+        from .. import paths
         return cls(paths.world_path(world), paths.model_path(),
                    urdf_xml if urdf_xml is not None else paths.robot_urdf())
 

@@ -8,15 +8,16 @@ import sys
 import threading
 import time
 
-from . import benchmath, processes
-from .benchmath import fmt
-from .gazebo import call_empty
-from .names import (CLOCK_TOPIC, COMMAND_TOPIC, CONTACTS_TOPIC, CONTROLLER_NODE, DEFAULT_START,
+from . import arithmetic
+from ..running import processes
+from .arithmetic import fmt
+from ..running.gazebo import call_empty
+from ..names import (CLOCK_TOPIC, COMMAND_TOPIC, CONTACTS_TOPIC, CONTROLLER_NODE, DEFAULT_START,
                     DEFAULT_WORLD, JOINT_STATES_TOPIC, MODEL_STATES_TOPIC, PAUSE_SERVICE,
                     ROSOUT_TOPIC, SCAN_TOPIC, SIMULATOR_NODE, SPAWN_SERVICE, TF_TOPIC,
                     UNPAUSE_SERVICE)
-from .session import SessionError
-from .summary import is_case
+from ..running.session import SessionError
+from ..analysis.summary import is_case
 
 WORLD, START = DEFAULT_WORLD, DEFAULT_START
 SCAN_PERIOD = 0.05                   # [s] sim: m2wr's laser runs at 20 Hz
@@ -118,9 +119,9 @@ def wait_counting(session, timeout=10.0):
 
 
 # obstacle_avoidance.py's rules on a rospy.Rate(20) loop of their own (loop_avoidance.py)
-LOOP_PROGRAM = (sys.executable, "-m", "m2wr_tools.loop_avoidance")
+LOOP_PROGRAM = (sys.executable, "-m", "m2wr_tools.bench.loop_avoidance")
 # obstacle_avoidance.py beside a behaviour spinning while switched off (switched_off_beside.py)
-BUSY_PROGRAM = (sys.executable, "-m", "m2wr_tools.switched_off_beside")
+BUSY_PROGRAM = (sys.executable, "-m", "m2wr_tools.bench.switched_off_beside")
 
 
 def start_loop(session, lockstep, clock_hz, extra=(), controller=None):
@@ -201,7 +202,7 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         listener.stop_counting()
         scans, answers, handled = (a - b for a, b in zip(after, before))
         edge = 0 if controller is None else 1     # a loop program (see every_scan_handled)
-        missing = benchmath.missing_periods(listener.scan_stamps[before[0]:after[0]], SCAN_PERIOD)
+        missing = arithmetic.missing_periods(listener.scan_stamps[before[0]:after[0]], SCAN_PERIOD)
         peak = processes.peak_rss_kib(sim_pid)
         with open(session.children["world"].log_path, errors="replace") as log:
             timeouts = sum("lockstep: " in line and "still at work" in line for line in log)
@@ -209,7 +210,7 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         stop_loop(session)
     result = {
         "lockstep": lockstep, "pub_clock_frequency_hz": clock_hz, "launch_args": list(extra),
-        "x_real_time": benchmath.rate(sim_s, wall_s), "sim_s": sim_s, "wall_s": wall_s,
+        "x_real_time": arithmetic.rate(sim_s, wall_s), "sim_s": sim_s, "wall_s": wall_s,
         "robot_touches": touches1 - touches0,
         "cpu_ms_per_sim_s": {
             "simulator": 1e3 * (cpu1[0] - cpu0[0]) / sim_s if sim_s > 0 else None,
@@ -220,9 +221,9 @@ def measure_loop(session, listener, name, lockstep, clock_hz, seconds, check_sec
         "check": {"scans_published": scans + missing, "scans_heard": scans,
                   "handled_by_controller": handled, "cmd_vel_answers": answers,
                   "missing_scans": missing,
-                  "every_scan_received": benchmath.every_scan_handled(scans, handled, missing,
+                  "every_scan_received": arithmetic.every_scan_handled(scans, handled, missing,
                                                                       edge),
-                  "verdict": benchmath.lockstep_verdict(scans, handled, answers, missing, edge),
+                  "verdict": arithmetic.lockstep_verdict(scans, handled, answers, missing, edge),
                   "lockstep_timeout_warnings": timeouts},
         "simulator_peak_rss_mib": peak / 1024.0 if peak else None,
     }
@@ -291,13 +292,14 @@ def soak(session, listener, minutes, clock_hz):
         stop_loop(session)
     errors = error_lines(session.log_dir, since=started)
     result = {
-        "minutes": minutes, "sim_s": sim1 - sim0, "x_real_time": benchmath.rate(sim1 - sim0, wall1 - wall0),
+        "minutes": minutes, "sim_s": sim1 - sim0,
+        "x_real_time": arithmetic.rate(sim1 - sim0, wall1 - wall0),
         "scans": len(stamps), "handled_by_controller": handled, "cmd_vel_answers": answers,
-        "scan_rate_hz_sim": benchmath.stamp_rate(stamps),
-        "missing_scans": benchmath.missing_periods(stamps, SCAN_PERIOD),
+        "scan_rate_hz_sim": arithmetic.stamp_rate(stamps),
+        "missing_scans": arithmetic.missing_periods(stamps, SCAN_PERIOD),
         "simulator_rss_mib": {"start": rss0 / 1024.0 if rss0 else None,
                               "end": rss1 / 1024.0 if rss1 else None,
-                              "growth_percent": benchmath.growth_percent(rss0, rss1)},
+                              "growth_percent": arithmetic.growth_percent(rss0, rss1)},
         "error_lines": len(errors), "first_errors": errors[:10],
     }
     say("  soak: %.0f s sim, scans at %s Hz sim, RSS %s -> %s MiB (%s %%), %d ERROR lines" % (

@@ -12,6 +12,8 @@ import socket
 import subprocess
 import time
 
+from ..tool_exit import Interrupted   # raised by raise_on_signals; tools end on it
+
 
 def free_port(host="127.0.0.1"):
     """A TCP port nobody listens on now (the kernel's pick). Another program may take it
@@ -234,11 +236,6 @@ def log_tail(path, lines=20):
     except OSError:
         return ""
     return "\n".join(text.rstrip().splitlines()[-lines:])
-
-
-class Interrupted(Exception):
-    """Ctrl-C (SIGINT) or SIGTERM, raised in the main thread by raise_on_signals' handler;
-    its text is the signal's name."""
 
 
 def raise_on_signals():

@@ -5,7 +5,7 @@ case. Same node name (reading_laser), topics, rules and log lines as the tutoria
 only what makes it act differs. The benchmark measures lockstep with it beside the tutorial's
 own program (a loop program against a scan-answering one).
 
-    python -m m2wr_tools.loop_avoidance [_rate:=20] [_timer:=true]
+    python -m m2wr_tools.bench.loop_avoidance [_rate:=20] [_timer:=true]
 
 With `_timer:=true` a rospy.Timer at the same rate acts instead of the loop.
 """
@@ -13,10 +13,14 @@ import rospy
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import LaserScan
 
-from . import tutorial_scripts
+from .. import tutorial_scripts, usage
 
 
-def main():
+def main(argv=None):
+    usage.parser("python -m m2wr_tools.bench.loop_avoidance", __doc__, examples=[
+        "python -m m2wr_tools.bench.loop_avoidance              # a rospy.Rate(20) loop",
+        "python -m m2wr_tools.bench.loop_avoidance _timer:=true _rate:=50"],
+        exit_statuses="Exit status: 0 when ROS shuts the node down.").parse_known_args(argv)
     tutorial = tutorial_scripts.load("obstacle_avoidance.py")
     rospy.init_node("reading_laser")
     hz = rospy.get_param("~rate", 20.0)
