@@ -96,7 +96,7 @@ class Wrenches(unittest.TestCase):
         self.assertGreater(abs(spinning), 2.0)        # over the drive's 5 N m holding it
         self.gazebo.clear_joint_forces("joint_left_wheel")
         # the drive's motor brings it to rest; how fast depends on how the robot rocks as the
-        # wheel stops (one CI run still read 0.79 rad/s 0.5 s after the clear): look for 2 s
+        # wheel stops (under load it may still spin 0.5 s after the clear): look for 2 s
         rates = []
         for _ in range(20):
             self.gazebo.wait_sim(0.1)
