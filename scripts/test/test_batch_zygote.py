@@ -6,11 +6,11 @@ import shutil
 import signal
 import sys
 import tempfile
-import time
 
 import pytest
 
 from m2wr_tools.running import processes, zygote
+from pybullet_gazebo.ros.testing import wait_until
 
 SCRIPT = """#!/usr/bin/env python3
 import os, sys, time
@@ -80,9 +80,8 @@ def test_an_uncaught_exception_prints_its_traceback_and_exits_1(warm):
 def test_sigint_to_its_group_reaches_the_script_and_stop_reports_its_exit(warm):
     z, path, env, tmp_path = warm
     child, log = start(z, path, env, tmp_path, "sleep")
-    deadline = time.monotonic() + 20.0
-    while "rospy initialised" not in read(log) and time.monotonic() < deadline:
-        time.sleep(0.05)
+    wait_until(lambda: "rospy initialised" in read(log), 20.0, "the script's 'rospy initialised'",
+               interval=0.05)
     assert child.running()
     assert os.getpgid(child.pid) == child.pid        # a process group of its own
     outcome = processes.stop([child], sigint_timeout=10.0)

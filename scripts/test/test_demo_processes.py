@@ -5,13 +5,13 @@ stopped by the test that starts them."""
 import os
 import signal
 import socket
-import time
 import uuid
 
 import pytest
 
 from m2wr_tools.running import processes
 from m2wr_tools.running.processes import Child
+from pybullet_gazebo.ros.testing import wait_until
 
 
 @pytest.fixture
@@ -52,9 +52,8 @@ def test_sigint_ends_a_well_behaved_child(tmp_path, run_env):
     # Between fork and exec the child still has this process's environment (so leftovers
     # cannot know it yet), and a SIGINT then is swallowed by the forked Python's handler; a
     # real child has long exec'd when the demo looks for it or stops it, so wait for that.
-    deadline = time.monotonic() + 5.0
-    while time.monotonic() < deadline and not exec_done(child.pid, b"sleep"):
-        time.sleep(0.01)
+    wait_until(lambda: exec_done(child.pid, b"sleep"), 5.0, "the child's exec of sleep",
+               interval=0.01)
     assert processes.leftovers(uri) == [child.pid]
     outcome = processes.stop([child], sigint_timeout=5.0, sigterm_timeout=1.0)
     assert outcome == {"sleeper": "exit -2"}
@@ -67,17 +66,13 @@ def test_escalates_to_sigterm_then_sigkill(tmp_path, run_env):
                  str(tmp_path / "deaf.log"))
     deafer = Child("deafer", ["bash", "-c", "trap '' INT TERM; echo ready; while :; do sleep 0.1; done"],
                    env, str(tmp_path / "deafer.log"))
-    deadline = time.monotonic() + 5.0
-    while time.monotonic() < deadline and not all(
-            "ready" in c.log_tail() for c in (deaf, deafer)):
-        time.sleep(0.05)
+    wait_until(lambda: all("ready" in c.log_tail() for c in (deaf, deafer)), 5.0,
+               "'ready' from both children", interval=0.05)
     outcome = processes.stop([deaf, deafer], sigint_timeout=0.5, sigterm_timeout=0.5)
     assert outcome == {"deaf": "SIGTERM", "deafer": "SIGKILL"}
     # the whole group went: deaf's `sleep` child too
-    deadline = time.monotonic() + 2.0
-    while processes.leftovers(uri) and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert processes.leftovers(uri) == []
+    wait_until(lambda: not processes.leftovers(uri), 2.0, "no process of the group left",
+               interval=0.05)
 
 
 def test_kill_leftovers_finds_orphans_by_environment(tmp_path, run_env):
@@ -88,9 +83,9 @@ def test_kill_leftovers_finds_orphans_by_environment(tmp_path, run_env):
     assert parent.wait(5.0) == 0
     orphan = int(parent.log_tail().split()[-1])
     parent.close()
-    deadline = time.monotonic() + 5.0        # while it execs, its /proc entry is in flux
-    while time.monotonic() < deadline and not exec_done(orphan, b"sleep"):
-        time.sleep(0.01)
+    # while it execs, its /proc entry is in flux
+    wait_until(lambda: exec_done(orphan, b"sleep"), 5.0, "the orphan's exec of sleep",
+               interval=0.01)
     assert processes.leftovers(uri) == [orphan]
     text = processes.kill_leftovers(uri)
     assert str(orphan) in text and "sleep 30" in text

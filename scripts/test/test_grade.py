@@ -5,7 +5,6 @@ import json
 import os
 import subprocess
 import textwrap
-import time
 
 import pytest
 
@@ -15,6 +14,7 @@ from m2wr_tools.running.commands import check, package_dir
 from m2wr_tools.grade import classroom, rules, sandbox, scoring
 from m2wr_tools.grade.report import svg
 from m2wr_tools.grade.spec import DEFAULT_SPEC, SpecError, load
+from pybullet_gazebo.ros.testing import wait_until
 
 GOOD = """\
 version: 1
@@ -154,9 +154,8 @@ def test_a_users_processes_are_listed_and_its_ended_ones_are_not():
     live = subprocess.Popen(["sleep", "30"])
     ended = subprocess.Popen(["true"])
     try:
-        deadline = time.monotonic() + 5
-        while processes.alive(ended.pid) and time.monotonic() < deadline:
-            time.sleep(0.01)                      # a zombie until waited for
+        # a zombie until waited for
+        wait_until(lambda: not processes.alive(ended.pid), 5, "'true' to end", interval=0.01)
         mine = sandbox.pids_of_user(os.getuid())
         assert live.pid in mine and ended.pid not in mine and os.getpid() not in mine
         assert live.pid not in sandbox.pids_of_user(os.getuid() + 12345)

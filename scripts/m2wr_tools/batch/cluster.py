@@ -29,9 +29,8 @@ from .rig import BATCH_TAG, RunOptions, close_rig, options_dict, run_scenario
 PROFILER_CALLBACKS = ("profile", "profile-cycle")
 # The embedded cluster's periodic chores, slowed: each process's event-loop tick (a blocked
 # loop check) runs every 20 ms by default, the system monitor (dashboard figures) every
-# 0.5 s, the nannies' memory check every 0.1 s. Idle, the driver (scheduler, nannies,
-# client) used 3.9 % of a core and each worker process 1.6 %; with these 0.9 % and 0.4 %
-# (measured): CPU the runs get back.
+# 0.5 s, the nannies' memory check every 0.1 s. Slowed, the idle driver (scheduler,
+# nannies, client) and worker processes give their share of a core back to the runs.
 QUIET_CLUSTER = {
     "distributed.worker.profile.enabled": False,          # see _RigTeardown
     "distributed.admin.tick.interval": "1s",

@@ -5,7 +5,6 @@ import json
 import math
 import os
 import subprocess
-import time
 import types
 
 import pytest
@@ -13,6 +12,7 @@ import pytest
 from m2wr_tools.running import processes
 from m2wr_tools.paths import ROOT
 from m2wr_tools.batch.scenarios import FREE_MARGIN, obstacle_distance
+from pybullet_gazebo.ros.testing import wait_until
 
 EVALUATE = os.path.join(ROOT, "scripts", "evaluate.sh")
 FIXTURES = os.path.join(ROOT, "scripts", "test", "fixtures")
@@ -60,17 +60,15 @@ class DaskProcesses:
     def wait_for_workers(self, count, timeout=90.0):
         """Until the scheduler's log shows `count` workers registered."""
         scheduler = self.children[0]
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
+
+        def registered():
             for child in self.children:
                 if not child.running():
                     raise AssertionError("%s exited (%s):\n%s" % (child.name, child.returncode,
                                                                    child.log_tail()))
-            if scheduler.log_tail(400).count("Register worker") >= count:
-                return
-            time.sleep(0.5)
-        raise AssertionError("the scheduler did not see %d workers within %.0f s:\n%s"
-                             % (count, timeout, scheduler.log_tail()))
+            return scheduler.log_tail(400).count("Register worker") >= count
+        wait_until(registered, timeout, "%d workers registered with the scheduler (its log: %s)"
+                   % (count, os.path.join(self.log_dir, "scheduler.log")), interval=0.5)
 
     def stop(self):
         """Workers first (they stop their simulators), then the scheduler."""
@@ -103,10 +101,11 @@ def assert_no_process_left(data):
     """No process of the batch (tagged M2WR_BATCH) is alive; kills any found, by PID."""
     tag = batch_tag(data)
     assert tag, "results.json names no batch tag"
-    deadline = time.monotonic() + 10.0
-    while processes.tagged("M2WR_BATCH", tag) and time.monotonic() < deadline:
-        time.sleep(0.2)
-    left = processes.kill_tagged("M2WR_BATCH", tag)
+    try:
+        wait_until(lambda: not processes.tagged("M2WR_BATCH", tag), 10.0,
+                   "the batch's processes to end", interval=0.2)
+    finally:
+        left = processes.kill_tagged("M2WR_BATCH", tag)     # by PID, whatever happened
     assert not left, "processes of the batch still running:\n%s" % left
 
 

@@ -8,9 +8,9 @@ import os
 import signal
 import socket
 import subprocess
-import time
 
 from m2wr_tools.analysis.scene import SCAN_HEIGHT, Scene
+from pybullet_gazebo.ros.testing import wait_until
 
 RUNS = 6
 
@@ -35,11 +35,11 @@ def test_a_killed_worker_has_its_runs_done_by_the_other(tmp_path, run_evaluate,
             # the victim is inside a run once its rig forked a controller (zygote.log)
             its_logs = os.path.join(str(output), "logs", "worker-%s-%d" % (
                 socket.gethostname(), victim.pid))
-            deadline = time.monotonic() + 240.0
-            while not glob.glob(os.path.join(its_logs, "zygote.log")):
+
+            def victim_in_a_run():
                 assert batch.poll() is None, "the batch ended before the kill"
-                assert time.monotonic() < deadline, "worker-2 never started a run"
-                time.sleep(0.2)
+                return glob.glob(os.path.join(its_logs, "zygote.log"))
+            wait_until(victim_in_a_run, 240.0, "worker-2 to start a run", interval=0.2)
             os.kill(victim.pid, signal.SIGKILL)
             assert victim.wait(10.0) == -signal.SIGKILL
             status = batch.wait(timeout=420)

@@ -6,8 +6,8 @@ and two lockstep runs are identical. Each case runs `python -m m2wr_tools.bench.
 own master, stopped by PID at its end).
 
 Real time varies from run to run: the moment a loop ticks against the drive's updates is left
-to the machine (measured, go to point from (0, 8) to (-6, 6): 13.8, 18.5 and 19.0 s; to
-(-3, 7): 9.4, 10.2 and 11.8 s). Lockstep gives a controller that takes no time, so it lies
+to the machine, and a bang-bang turn that overshoots its tolerance once costs seconds.
+Lockstep gives a controller that takes no time, so it lies
 in that spread or a little under it; REAL_TIME_SPREAD is the band allowed around the
 real-time runs of this test.
 

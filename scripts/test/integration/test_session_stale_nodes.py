@@ -4,10 +4,10 @@ and rospy nodes; stale_nodes.py tells the story)."""
 import os
 import sys
 import textwrap
-import time
 import xmlrpc.client
 
 from m2wr_tools.running.session import Session
+from pybullet_gazebo.ros.testing import wait_until
 
 NODE = "/stale_probe"
 # a rospy node that logs once (rospy then subscribes /rosout_disable_topics_generation, the
@@ -32,10 +32,8 @@ def start_probe(session, tmp_path):
     script = tmp_path / "stale_probe.py"
     script.write_text(PROGRAM)
     session.start_controller([sys.executable, str(script)], log_name="stale_probe")
-    deadline = time.monotonic() + 30
-    while lookup(session, NODE) is None or not cached_param_subscribed(session):
-        assert time.monotonic() < deadline, "the probe node did not register within 30 s"
-        time.sleep(0.1)
+    wait_until(lambda: lookup(session, NODE) is not None and cached_param_subscribed(session),
+               30, "the probe node's registration and its cached parameter", interval=0.1)
     return lookup(session, NODE)
 
 

@@ -17,6 +17,7 @@ import pytest
 from m2wr_tools.running import processes
 from m2wr_tools.paths import ROOT
 from m2wr_tools.running.session import Session
+from pybullet_gazebo.ros.testing import wait_until
 
 CHROMIUM = "/usr/bin/chromium"
 FLAGS = ["--no-sandbox", "--headless", "--use-gl=angle", "--use-angle=swiftshader",
@@ -25,17 +26,6 @@ FLAGS = ["--no-sandbox", "--headless", "--use-gl=angle", "--use-angle=swiftshade
 PROBE = os.path.join(os.path.dirname(__file__), "web_probe_node.py")
 STATUS = re.compile(r"sim (\d+\.\d+) s .*?(paused|running)")
 ROBOT = re.compile(r"m2wr x\s*(-?\d+\.\d+) y\s*(-?\d+\.\d+) yaw\s*(-?\d+\.\d+)")
-
-
-def wait_until(predicate, timeout, what):
-    deadline = time.monotonic() + timeout
-    value = None
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.1)
-    raise AssertionError("%s: not within %.0f s (last seen: %r)" % (what, timeout, value))
 
 
 @pytest.fixture(scope="module")

@@ -4,11 +4,11 @@ rospy ends it: its shutdown hooks run, the code after spin() runs, exit status 0
 the batch benchmark's stop stage; timed tests are not this suite's way.)"""
 import os
 import signal
-import time
 
 import pytest
 
 from m2wr_tools.running import processes, zygote
+from pybullet_gazebo.ros.testing import wait_until
 
 PROGRAM = """#!/usr/bin/env python3
 import rospy
@@ -29,9 +29,8 @@ def master(tmp_path):
                ROS_HOSTNAME="localhost", ROS_LOG_DIR=str(tmp_path / "ros"))
     child = processes.Child("master", ["rosmaster", "--core", "-p", str(port)], env,
                             str(tmp_path / "master.log"))
-    deadline = time.monotonic() + 20.0
-    while not processes.port_in_use(port) and time.monotonic() < deadline:
-        time.sleep(0.1)
+    wait_until(lambda: processes.port_in_use(port), 20.0, "rosmaster on port %d" % port,
+               interval=0.1)
     yield env
     processes.stop([child], sigint_timeout=5.0)
 

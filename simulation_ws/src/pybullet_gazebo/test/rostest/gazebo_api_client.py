@@ -2,7 +2,6 @@
 user's program calls them, m2wr and a small SDF crate to spawn, and a snapshot of the world
 (model names and poses) to show that a refused request changed nothing."""
 import os
-import time
 
 import rospkg
 import rospy
@@ -11,7 +10,7 @@ from gazebo_msgs import srv
 from geometry_msgs.msg import Point, Pose, Quaternion
 from std_srvs.srv import Empty
 
-from pybullet_gazebo.ros.testing import service
+from pybullet_gazebo.ros.testing import service, wait_until
 
 CRATE_SDF = """<?xml version="1.0"?>
 <sdf version="1.6"><model name="crate"><link name="body">
@@ -59,12 +58,8 @@ class Gazebo:
     def wait_sim(self, seconds, timeout=30.0):
         """Returns once sim time advanced by `seconds`; AssertionError after `timeout` wall s."""
         target = self.sim_time() + seconds
-        deadline = time.monotonic() + timeout
-        while self.sim_time() < target:
-            if time.monotonic() > deadline:
-                raise AssertionError("sim time stuck at %.3f s, waiting for %.3f s"
-                                     % (self.sim_time(), target))
-            time.sleep(0.01)
+        wait_until(lambda: self.sim_time() >= target, timeout,
+                   "sim time %.3f s (from %.3f s)" % (target, target - seconds), interval=0.01)
 
     def snapshot(self):
         """(model names, their poses rounded to 1 mm): what a refused request must not change."""

@@ -17,7 +17,7 @@ from geometry_msgs.msg import Twist, Vector3
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gazebo_api_client import Gazebo, pose, spawn_crate   # noqa: E402
-from pybullet_gazebo.ros.testing import NodeLog   # noqa: E402
+from pybullet_gazebo.ros.testing import NodeLog, wait_until   # noqa: E402
 
 EARTH = Vector3(0.0, 0.0, -9.8)
 
@@ -126,11 +126,8 @@ class Physics(unittest.TestCase):
             now = self.gazebo.get_physics_properties()
             self.assertEqual((now.time_step, now.max_update_rate, now.gravity.z),
                              (0.005, 200.0, -9.8), change)
-            deadline = time.monotonic() + 10.0
-            while not any(warning in text for _, text in self.simulator_log.since(0)):
-                if time.monotonic() > deadline:
-                    self.fail("%s: the simulator logged no warning '%s'" % (change, warning))
-                time.sleep(0.02)
+            wait_until(lambda: any(warning in text for _, text in self.simulator_log.since(0)),
+                       10, "%s: the simulator's warning '%s'" % (change, warning))
         self.gazebo.wait_sim(0.05)                       # the simulation goes on
 
 

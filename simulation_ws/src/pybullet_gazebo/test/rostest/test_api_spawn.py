@@ -9,7 +9,6 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
 
 import rospy
@@ -17,7 +16,7 @@ import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gazebo_api_client import CRATE_SDF, Gazebo, m2wr_urdf, pose   # noqa: E402
-from pybullet_gazebo.ros.testing import NodeLog   # noqa: E402
+from pybullet_gazebo.ros.testing import NodeLog, wait_until   # noqa: E402
 
 
 class SpawnDelete(unittest.TestCase):
@@ -75,11 +74,8 @@ class SpawnDelete(unittest.TestCase):
         self.assertIn("crate_in", self.names())
         self.assertIn("m2wr", self.names())
         warning = "puts 'crate_in' inside 'm2wr'; spawned anyway, as Gazebo does"
-        deadline = time.monotonic() + 10.0
-        while not any(warning in text for _, text in self.simulator_log.since(0)):
-            if time.monotonic() > deadline:
-                self.fail("the simulator logged no warning '%s'" % warning)
-            time.sleep(0.02)
+        wait_until(lambda: any(warning in text for _, text in self.simulator_log.since(0)),
+                   10, "the simulator's warning '%s'" % warning)
         self.gazebo.wait_sim(0.3)                 # physics pushes them apart; both stay sane
         self.assertTrue(self.gazebo.get_model_state("m2wr", "").success)
         self.gazebo.delete_model("crate_in")

@@ -7,7 +7,6 @@ input, with nothing changed (on the two topics: dropped, with a warning naming i
 import math
 import os
 import sys
-import time
 import unittest
 
 import rospy
@@ -17,19 +16,11 @@ from geometry_msgs.msg import Twist, Vector3
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gazebo_api_client import Gazebo, pose, spawn_crate, spawn_m2wr   # noqa: E402
-from pybullet_gazebo.ros.testing import NodeLog, wait_for_message   # noqa: E402
+from pybullet_gazebo.ros.testing import NodeLog, wait_for_message, wait_until   # noqa: E402
 
 
 def xyz(p):
     return (p.position.x, p.position.y, p.position.z)
-
-
-def wait_until(check, what, timeout=10.0):
-    deadline = time.monotonic() + timeout
-    while not check():
-        if time.monotonic() > deadline:
-            raise AssertionError("%s: not within %.0f s" % (what, timeout))
-        time.sleep(0.02)
 
 
 class States(unittest.TestCase):
@@ -99,15 +90,15 @@ class States(unittest.TestCase):
 
     def test_the_state_topics_move_models_and_links(self):
         publisher = rospy.Publisher("/gazebo/set_model_state", ModelState, queue_size=1)
-        wait_until(lambda: publisher.get_num_connections() > 0, "simulator subscribed")
+        wait_until(publisher.get_num_connections, 10, "the simulator's subscription")
         publisher.publish(ModelState("crate", pose(-2.0, 4.0, 0.15), Twist(), "world"))
         wait_until(lambda: abs(self.gazebo.get_model_state("crate", "").pose.position.y - 4.0)
-                   < 0.01, "crate moved by /gazebo/set_model_state")
+                   < 0.01, 10, "the crate moved by /gazebo/set_model_state")
         links = rospy.Publisher("/gazebo/set_link_state", LinkState, queue_size=1)
-        wait_until(lambda: links.get_num_connections() > 0, "simulator subscribed")
+        wait_until(links.get_num_connections, 10, "the simulator's subscription")
         links.publish(LinkState("crate::body", pose(-2.0, -4.0, 0.15), Twist(), ""))
         wait_until(lambda: abs(self.gazebo.get_model_state("crate", "").pose.position.y + 4.0)
-                   < 0.01, "crate moved by /gazebo/set_link_state")
+                   < 0.01, 10, "the crate moved by /gazebo/set_link_state")
 
     def test_model_states_and_link_states_list_every_model_and_link(self):
         models = wait_for_message("/gazebo/model_states", ModelStates)
@@ -125,7 +116,8 @@ class States(unittest.TestCase):
         def crate_y():
             states = wait_for_message("/gazebo/model_states", ModelStates)
             return states.pose[states.name.index("crate")].position.y
-        wait_until(lambda: abs(crate_y() - 7.0) < 0.01, "model_states shows the crate's new pose")
+        wait_until(lambda: abs(crate_y() - 7.0) < 0.01, 10,
+                   "/gazebo/model_states showing the crate's new pose")
 
     def test_bad_input_is_answered_and_changes_nothing(self):
         self.gazebo.pause_physics()               # nothing moves but what a request moves
@@ -174,7 +166,7 @@ class States(unittest.TestCase):
         models = rospy.Publisher("/gazebo/set_model_state", ModelState, queue_size=10)
         links = rospy.Publisher("/gazebo/set_link_state", LinkState, queue_size=10)
         wait_until(lambda: models.get_num_connections() > 0 and links.get_num_connections() > 0,
-                   "simulator subscribed")
+                   10, "the simulator's subscriptions to both state topics")
         self.gazebo.pause_physics()
         self.addCleanup(self.gazebo.unpause_physics)
         before = self.gazebo.snapshot()
@@ -192,7 +184,7 @@ class States(unittest.TestCase):
         for publisher, message, warning in messages:     # each reason said, none throttled
             publisher.publish(message)
             wait_until(lambda: any(warning in text for _, text in self.simulator_log.since(0)),
-                       "the simulator's warning '%s'" % warning)
+                       10, "the simulator's warning '%s'" % warning)
         self.assertEqual(self.gazebo.snapshot(), before)
         self.gazebo.unpause_physics()
         self.gazebo.wait_sim(0.05)                       # the simulation goes on

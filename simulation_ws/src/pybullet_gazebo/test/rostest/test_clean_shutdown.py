@@ -18,7 +18,7 @@ import rosgraph
 import rospkg
 import rostest
 
-from pybullet_gazebo.ros.testing import VirtualDisplay
+from pybullet_gazebo.ros.testing import VirtualDisplay, wait_until
 
 RUNS_SIGINT = 5
 RUNS_SIGTERM = 2
@@ -39,12 +39,12 @@ class CleanShutdownTest(unittest.TestCase):
              "__ns:=" + namespace, "_real_time_factor:=0", "_gui:=%s" % str(gui).lower()],
             stdout=output, stderr=subprocess.STDOUT, start_new_session=True, env=env)
         try:
-            deadline = time.monotonic() + 40.0
             topic = namespace + "/gazebo/model_states"
-            while topic not in [t for t, _ in self.master.getPublishedTopics("/")]:
+
+            def up():
                 self.assertIsNone(node.poll(), "the simulator ended while starting")
-                self.assertLess(time.monotonic(), deadline, "the simulator never came up")
-                time.sleep(0.1)
+                return topic in [t for t, _ in self.master.getPublishedTopics("/")]
+            wait_until(up, 40, "the simulator to publish %s" % topic, interval=0.1)
             time.sleep(self.rng.uniform(0.2, 1.5))          # mid-run, at a varying step
             os.killpg(node.pid, signum)
             node.wait(EXIT_WITHIN)

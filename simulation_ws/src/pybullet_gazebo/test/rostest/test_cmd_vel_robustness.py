@@ -25,7 +25,7 @@ from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reliability import ClockWatch, OdomWatch, all_finite, state   # noqa: E402
-from pybullet_gazebo.ros.testing import (NodeLog, service, wait_for_message,   # noqa: E402
+from pybullet_gazebo.ros.testing import (NodeLog, service, wait_for_message, wait_until,  # noqa: E402
                                          wait_until_sim_time)
 
 FIELDS = ("linear.x", "linear.y", "linear.z", "angular.x", "angular.y", "angular.z")
@@ -58,9 +58,7 @@ class CmdVelRobustnessTest(unittest.TestCase):
         cls.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=10)
         cls.reset_world = service("/gazebo/reset_world", Empty, timeout=30)
         wait_for_message("/odom", Odometry, timeout=30)
-        deadline = time.monotonic() + 10
-        while cls.cmd.get_num_connections() == 0 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_until(cls.cmd.get_num_connections, 10, "the simulator's subscription to /cmd_vel")
         wait_until_sim_time(rospy.get_time() + 1.0)          # dropped from z 0.5, settled
 
     def publish_for(self, messages, wall_seconds, rate=20.0):

@@ -13,7 +13,8 @@ from nav_msgs.msg import Odometry
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reliability import state   # noqa: E402
-from pybullet_gazebo.ros.testing import wait_for_message, wait_until_sim_time   # noqa: E402
+from pybullet_gazebo.ros.testing import (wait_for_message, wait_until,   # noqa: E402
+                                         wait_until_sim_time)
 
 SPEED = 0.5            # [m/s]
 
@@ -25,9 +26,7 @@ class CmdVelTimeoutTest(unittest.TestCase):
         cls.timeout = rospy.get_param("~timeout")
         cls.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
         wait_for_message("/odom", Odometry, timeout=30)
-        deadline = time.monotonic() + 10
-        while cls.cmd.get_num_connections() == 0 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_until(cls.cmd.get_num_connections, 10, "the simulator's subscription to /cmd_vel")
         wait_until_sim_time(rospy.get_time() + 1.0)          # dropped from z 0.5, settled
 
     def drive(self, wall_seconds):

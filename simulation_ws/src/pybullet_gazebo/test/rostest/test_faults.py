@@ -25,7 +25,8 @@ from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reliability import ClockWatch, OdomWatch, state   # noqa: E402
-from pybullet_gazebo.ros.testing import service, wait_for_message, wait_until_sim_time  # noqa: E402
+from pybullet_gazebo.ros.testing import (service, wait_for_message, wait_until,  # noqa: E402
+                                         wait_until_sim_time)
 
 # The tutorial's controller, in catkin_ws (which overlays this workspace). catkin's run_tests
 # for simulation_ws sees only this workspace's packages, so the script is found by its place
@@ -64,12 +65,8 @@ class CommandWatch:
             return sum(1 for t, _ in self.received if t > wall_time)
 
     def wait_after(self, wall_time, timeout=30.0):
-        deadline = time.monotonic() + timeout
-        while self.count_after(wall_time) == 0:
-            if time.monotonic() > deadline:
-                raise AssertionError("no /cmd_vel within %.0f s: is the controller running?"
-                                     % timeout)
-            time.sleep(0.05)
+        wait_until(lambda: self.count_after(wall_time), timeout,
+                   "a /cmd_vel from the controller (is it running?)", interval=0.05)
 
 
 class FaultsTest(unittest.TestCase):

@@ -9,7 +9,6 @@ brings (the master's /rosout node and its /rosout_agg, this test node's own serv
 gazebo_ros's ros_network checker does with `strict: true`.
 """
 import os
-import time
 import unittest
 import xmlrpc.client
 
@@ -20,6 +19,8 @@ import rosservice
 import rostest
 import yaml
 from roslib.message import get_message_class, get_service_class
+
+from pybullet_gazebo.ros.testing import wait_until
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 HARNESS_NODES = ("/rosout",)
@@ -53,9 +54,8 @@ class GazeboApiConformance(unittest.TestCase):
             cls.api = yaml.safe_load(source)
         cls.me = rospy.get_name()
         cls.master = rosgraph.Master(cls.me)
-        end = time.monotonic() + 30.0
-        while rospy.get_rostime().to_sec() == 0.0 and time.monotonic() < end:
-            time.sleep(0.1)                     # /clock flows once the world runs
+        # /clock flows once the world runs
+        wait_until(lambda: rospy.get_rostime().to_sec(), 30, "a first /clock", interval=0.1)
         cls.state = cls.master.getSystemState()
 
     # --- the list, item by item ----------------------------------------------------------------

@@ -17,6 +17,7 @@ import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reliability import node_pid   # noqa: E402
+from pybullet_gazebo.ros.testing import wait_until   # noqa: E402
 
 EXIT_WITHIN = 5.0          # [s] wall from the kill to roslaunch's exit
 
@@ -25,14 +26,6 @@ def free_port():
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
         probe.bind(("127.0.0.1", 0))
         return probe.getsockname()[1]
-
-
-def wait_for(condition, timeout, what):
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            raise AssertionError("%s within %.0f s" % (what, timeout))
-        time.sleep(0.1)
 
 
 class SimulatorKilledTest(unittest.TestCase):
@@ -52,7 +45,7 @@ class SimulatorKilledTest(unittest.TestCase):
                     return "/clock" in [t for t, _ in master.getPublishedTopics("/")]
                 except (OSError, rosgraph.MasterException):
                     return False
-            wait_for(clock_published, 40, "the simulator published no /clock")
+            wait_until(clock_published, 40, "the simulator to publish /clock", interval=0.1)
             pid = node_pid("/gazebo", master_uri)
             with open("/proc/%d/cmdline" % pid) as source:
                 self.assertIn("gazebo_world", source.read())

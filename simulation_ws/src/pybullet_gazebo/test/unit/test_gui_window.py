@@ -21,6 +21,7 @@ from pybullet_gazebo.engine.sdf_world import load_world, model_path_from_env
 from pybullet_gazebo.engine.transforms import Pose
 from pybullet_gazebo.engine.world import World
 from pybullet_gazebo.gui import window as gui_window
+from pybullet_gazebo.ros.testing import wait_until
 
 SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 STEP = 0.005
@@ -65,9 +66,8 @@ def run_window(tmp_path, world, urdf, rays, seconds=1.0):
     notes = []
     window = gui_window.GuiWindow(world, 20.0, rays, False, notes.append, notes.append,
                                   viewer=[sys.executable, "-c", RECORDER, record])
-    started = time.monotonic() + 20.0
-    while not os.path.exists(record) and time.monotonic() < started:   # a busy machine
-        time.sleep(0.05)
+    # 20 s: the viewer's interpreter starts slowly on a busy machine
+    wait_until(lambda: os.path.exists(record), 20.0, "the viewer's first write", interval=0.05)
     time.sleep(0.2)
     robot = world.spawn_urdf("m2wr", urdf, Pose.from_xyz_rpy(0, 8, 0.5))
     world.step()                # the first scan loads the compiled ray caster (seconds)

@@ -22,6 +22,7 @@ from pybullet_gazebo.engine.specs import (CollisionSpec, LinkSpec, Mesh, ModelSp
                                           WorldSpec)
 from pybullet_gazebo.engine.transforms import Pose
 from pybullet_gazebo.engine.world import World
+from pybullet_gazebo.ros.testing import wait_until
 from pybullet_gazebo.web import site
 from pybullet_gazebo.web.frames import FrameBuilder, MAX_HITS, ray_sensors
 from pybullet_gazebo.web.live import WebView
@@ -188,9 +189,7 @@ def test_the_server_answers_bad_messages_and_passes_good_ones_on():
         assert hello["type"] == "hello" and hello["scene"]["world"] == "w" and hello["control"]
         assert [a["type"] for a in answers] == ["error"] * 3
         assert "not JSON" in answers[0]["text"] and "unknown message" in answers[1]["text"]
-        deadline = time.monotonic() + 5
-        while len(ops) < 2 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_until(lambda: len(ops) >= 2, 5, "the pause and reset calls", interval=0.05)
         assert ops == ["pause", "reset"]
     finally:
         server.close()
@@ -234,10 +233,8 @@ def test_fifty_pages_get_frames_and_a_frame_never_waits_for_them():
         worst = asyncio.run(pages())
         assert got == ["frame"] * 50
         assert worst < 0.005                        # [s]: handed over, never sent inline
-        deadline = time.monotonic() + 5
-        while server.watchers and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert server.watchers == 0                 # closed pages are forgotten
+        # closed pages are forgotten
+        wait_until(lambda: server.watchers == 0, 5, "no page watching", interval=0.05)
     finally:
         server.close()
 

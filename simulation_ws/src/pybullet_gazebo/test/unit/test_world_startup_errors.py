@@ -12,11 +12,11 @@ import os
 import socket
 import subprocess
 import sys
-import time
 
 import pytest
 
 from pybullet_gazebo.engine.sdf_world import WorldFileError, load_world
+from pybullet_gazebo.ros.testing import wait_until
 
 PKG = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 NODE = os.path.join(PKG, "nodes", "gazebo_world")
@@ -171,11 +171,12 @@ def test_the_trap_notices_a_node_that_goes_on_to_ros(tmp_path):
     listener, uri = trap()
     process = start("world01", uri, str(tmp_path))
     try:
-        deadline = time.monotonic() + TIMEOUT
-        while not contacted(listener):
+
+        def contacted_while_running():
             assert process.poll() is None, process.communicate()[1]
-            assert time.monotonic() < deadline, "world01 never contacted the master"
-            time.sleep(0.05)
+            return contacted(listener)
+        wait_until(contacted_while_running, TIMEOUT, "world01's call to the master",
+                   interval=0.05)
     finally:
         process.kill()
         process.communicate()

@@ -17,13 +17,12 @@ Who gets which tick:
 So a node that reads only /tf and the watching topics (model_states, link_states,
 joint_states: limited in wall time already) is a watcher; /tf itself is never limited.
 
-Why: every message wakes its subscriber. On the 2-core machine, in lockstep at ~30x real time,
-/clock was 80 of the ~106 messages per sim second the benchmark's rviz-like listeners woke up
-for (20 Hz of sim time to each of 4 processes); each wake-up costs the simulator's thread a
-socket write (py-spy: 12 % of its wall time went to /clock's writes) and the cores the
-listener's own work, while the simulator and the controller need both. Limited, the
-listeners' CPU per sim second fell from 9.4 to 4.9 ms (medians of 7 rounds, same run). A
-display draws 30 frames per wall second: 600 ticks per wall second show nothing more.
+Why: every message wakes its subscriber. Far faster than real time, /clock is most of the
+messages an rviz-like listener wakes up for (ticks at 20 Hz of sim time become hundreds per
+wall second); each wake-up costs the simulator's thread a socket write and the cores the
+listener's own work, while the simulator and the controller need both. A display draws 30
+frames per wall second: 600 ticks per wall second show nothing more. The listeners' cost
+with and without the limit: docs/performance.md.
 """
 import math
 import time

@@ -2,11 +2,10 @@
 few steps (/clock, the laser scan).
 
 rospy's queued publisher (queue_size=N) hands each message to a writer thread per
-subscriber and then calls time.sleep(0) to let that thread run: in the lockstep loop, a
-wall-time profile of the simulator's main thread (py-spy --idle) showed about 20 % of it in
-that one line, the GIL going back and forth after every publish. rospy's synchronous mode
-(queue_size=None) writes the serialized message straight into each subscriber's socket:
-measured +16 % to +31 % on the whole loop.
+subscriber and then calls time.sleep(0) to let that thread run: in the lockstep loop the
+simulator's main thread then spends much of its wall time in that one line, the GIL going
+back and forth after every publish. rospy's synchronous mode (queue_size=None) writes the
+serialized message straight into each subscriber's socket, and the loop runs faster for it.
 
 What synchronous writing costs: `sendall` waits when a subscriber's socket buffer is full,
 so a subscriber that reads slower than the simulator publishes (or a stopped process)

@@ -1,5 +1,5 @@
-"""Helpers for the rostest suites: waiting for messages and services with explicit time-outs,
-reading sim time and model poses, collecting a node's /rosout lines (NodeLog) and the
+"""Helpers for the rostest suites: waiting for a condition (wait_until, the one way a test
+waits), for messages and services with explicit time-outs, reading sim time and model poses, collecting a node's /rosout lines (NodeLog) and the
 simulator's touches from /gazebo/contacts (ContactLog), an Xvfb server for tests of windows
 (VirtualDisplay). Used by test nodes only."""
 import os
@@ -11,6 +11,22 @@ import rospy
 from gazebo_msgs.srv import GetModelState
 
 from pybullet_gazebo.engine.transforms import wrap_angle, yaw_from_quaternion
+
+
+def wait_until(predicate, timeout, what, interval=0.02):
+    """Calls `predicate()` every `interval` wall s until it returns something truthy and
+    returns that value. After `timeout` wall s, AssertionError naming `what` (a phrase such
+    as "a subscriber on /cmd_vel") and the last value the predicate returned. The predicate
+    is called at least once, and once more at the deadline; an exception in it propagates."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() >= deadline:
+            raise AssertionError("timed out waiting for %s within %.1f s (last value: %r)"
+                                 % (what, timeout, value))
+        time.sleep(max(0.0, min(interval, deadline - time.monotonic())))
 
 
 def wait_for_message(topic, msg_type, timeout=10.0):

@@ -21,7 +21,8 @@ from gazebo_msgs.srv import (GetJointProperties, GetModelState, GetWorldProperti
 from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty
 
-from pybullet_gazebo.ros.testing import model_pose, service, wait_until_sim_time, yaw_of
+from pybullet_gazebo.ros.testing import (model_pose, service, wait_until, wait_until_sim_time,
+                                         yaw_of)
 
 CLIENT = ["rosrun", "gazebo_ros", "spawn_model"]
 CRATE = """<sdf version="1.6"><model name="crate"><link name="body">
@@ -46,14 +47,6 @@ def start(*args):
     """Starts the client in the background (its own process group)."""
     return subprocess.Popen(CLIENT + list(args), stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE, text=True, start_new_session=True)
-
-
-def wait_for(predicate, timeout, what):
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError("%s: not within %.0f s" % (what, timeout))
-        time.sleep(0.1)
 
 
 class SpawnFlagsTest(unittest.TestCase):
@@ -122,7 +115,8 @@ class SpawnFlagsTest(unittest.TestCase):
     def test_b_deletes_the_model_when_interrupted(self):
         bonded = start("-urdf", "-param", "/robot_description", "-model", "bonded", "-x", "-6", "-b")
         try:
-            wait_for(lambda: "bonded" in models(), 30, "model 'bonded' spawned")
+            wait_until(lambda: "bonded" in models(), 30, "model 'bonded' to be spawned",
+                       interval=0.1)
             time.sleep(0.5)
             self.assertIsNone(bonded.poll(), "spawn_model -b ended on its own")
             os.killpg(bonded.pid, signal.SIGINT)

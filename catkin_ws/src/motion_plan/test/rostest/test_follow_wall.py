@@ -13,7 +13,6 @@ Parameters (~): duration [s sim], min_wall, max_wall [m], loops, direction
 """
 import math
 import threading
-import time
 import unittest
 
 import rospy
@@ -23,7 +22,7 @@ from sensor_msgs.msg import LaserScan
 from std_srvs.srv import SetBool
 
 from pybullet_gazebo.ros.testing import (ContactLog, NodeLog, service, sim_time,
-                                         wait_for_message, yaw_of)
+                                         wait_for_message, wait_until_sim_time, yaw_of)
 
 
 RIGHT_UP_TO = math.radians(15.0)
@@ -52,10 +51,7 @@ class FollowWallTest(unittest.TestCase):
         wait_for_message("/odom", Odometry, timeout=60)
         service("/wall_follower_switch", SetBool, timeout=30)(True)
         cls.start = sim_time()
-        deadline = time.monotonic() + wall_timeout
-        while sim_time() < cls.start + cls.duration and time.monotonic() < deadline \
-                and not rospy.is_shutdown():
-            time.sleep(0.05)
+        wait_until_sim_time(cls.start + cls.duration, timeout=wall_timeout)
         cls.end = sim_time()
 
     @classmethod

@@ -21,7 +21,8 @@ import rostest
 from nav_msgs.msg import Odometry
 from std_srvs.srv import Empty
 
-from pybullet_gazebo.ros.testing import ContactLog, NodeLog, sim_time, wait_for_message
+from pybullet_gazebo.ros.testing import (ContactLog, NodeLog, sim_time, wait_for_message,
+                                         wait_until)
 
 TOLERANCE = 0.3             # [m]
 
@@ -43,39 +44,30 @@ class Bug2Test(unittest.TestCase):
         for name in ("/go_to_point_switch", "/wall_follower_switch", "/gazebo/unpause_physics"):
             rospy.wait_for_service(name, timeout=60)
         master = rosgraph.Master("/test_bug2")
-        deadline = time.monotonic() + 60
-        while not any(topic == "/odom" and "/bug2" in nodes
-                      for topic, nodes in master.getSystemState()[1]):
-            if time.monotonic() > deadline:
-                raise AssertionError("/bug2 did not subscribe /odom within 60 s")
-            time.sleep(0.1)
+        wait_until(lambda: any(topic == "/odom" and "/bug2" in nodes
+                               for topic, nodes in master.getSystemState()[1]),
+                   60, "/bug2's subscription to /odom", interval=0.1)
         time.sleep(1.0)                                 # the publishers' connections are made
         rospy.ServiceProxy("/gazebo/unpause_physics", Empty)()
         wait_for_message("/odom", Odometry, timeout=60)
         # bug 2's set_model_state, from its parameters: its log line on /rosout was lost
         # once in CI (a connection to its /rosout made twice as it started)
-        deadline = time.monotonic() + 60
-        while not (rospy.has_param("/bug2/placed_at") or rospy.has_param("/bug2/not_placed")):
-            if time.monotonic() > deadline:
-                raise AssertionError("/bug2 did not call set_model_state within 60 s")
-            time.sleep(0.05)
+        wait_until(lambda: (rospy.has_param("/bug2/placed_at")
+                            or rospy.has_param("/bug2/not_placed")),
+                   60, "/bug2's call to set_model_state (param /bug2/placed_at)", interval=0.05)
         cls.placed = rospy.has_param("/bug2/placed_at")
         cls.start = rospy.get_param("/bug2/placed_at", 0.0)
-        deadline = time.monotonic() + wall_timeout
-        cls.reached = None
-        while time.monotonic() < deadline and not rospy.is_shutdown():
-            if sim_time() > cls.start + cls.duration:
-                break
+
+        def goal_reached_or_time_up():
             done = [t for t, text in cls.log.since(cls.start) if text.startswith("goal reached")]
-            if done:
-                cls.reached = done[0]
-                break
-            time.sleep(0.05)
+            return done or sim_time() > cls.start + cls.duration
+        outcome = wait_until(goal_reached_or_time_up, wall_timeout,
+                             "bug 2's 'goal reached' or the end of its %.0f s of sim time"
+                             % cls.duration, interval=0.05)
+        cls.reached = outcome[0] if isinstance(outcome, list) else None
         if cls.reached is not None:          # the /odom the controller saw may still be queued
-            settle = time.monotonic() + 5.0
-            while time.monotonic() < settle and not any(
-                    t >= cls.reached for t, _, _ in list(cls.poses)):
-                time.sleep(0.05)
+            wait_until(lambda: any(t >= cls.reached for t, _, _ in list(cls.poses)), 5.0,
+                       "the /odom of the tick that reached the goal", interval=0.05)
         # the odometry of the tick that reached the goal is stamped with that tick's time, and
         # may be in before this node's /clock has got there: keep it in the run
         cls.end = max(sim_time(), cls.reached or 0.0)

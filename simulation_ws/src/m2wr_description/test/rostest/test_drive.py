@@ -24,7 +24,7 @@ from std_srvs.srv import Empty
 from gazebo_msgs.srv import GetModelState
 from tf2_msgs.msg import TFMessage
 
-from pybullet_gazebo.ros.testing import (service, unwrap_angle, wait_for_message,
+from pybullet_gazebo.ros.testing import (service, unwrap_angle, wait_for_message, wait_until,
                                          wait_until_sim_time, yaw_of)
 
 WHEEL_RADIUS = 0.1          # [m]
@@ -44,9 +44,7 @@ class DriveTest(unittest.TestCase):
         cls.last_odom = None
         rospy.Subscriber("/odom", Odometry, cls.on_odom)
         wait_for_message("/odom", Odometry, timeout=30)
-        deadline = time.monotonic() + 10
-        while cls.cmd.get_num_connections() == 0 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_until(cls.cmd.get_num_connections, 10, "the simulator's subscription to /cmd_vel")
         wait_until_sim_time(rospy.get_time() + 1.0)          # dropped from z 0.5, settled
 
     @classmethod
@@ -110,11 +108,10 @@ class DriveTest(unittest.TestCase):
         self.pause()
         try:
             stamp, x, y, yaw = self.state()
-            deadline = time.monotonic() + 5
-            while (self.last_odom.header.stamp.to_sec() < stamp - DRIVE_PERIOD - 0.001
-                   and time.monotonic() < deadline):
-                time.sleep(0.01)
-            odom = self.last_odom
+            odom = wait_until(
+                lambda: (self.last_odom.header.stamp.to_sec() >= stamp - DRIVE_PERIOD - 0.001
+                         and self.last_odom), 5,
+                "the /odom of the last drive update before the pause", interval=0.01)
         finally:
             self.unpause()
         self.assertLessEqual(stamp - odom.header.stamp.to_sec(), DRIVE_PERIOD + 0.001,
@@ -133,9 +130,8 @@ class DriveTest(unittest.TestCase):
         # the chassis pitches as it starts (the twist peaks near 0.7 m/s about 0.4 s after
         # the command reaches the wheels), so the second is counted from the moment it does:
         # free-running, the message may arrive a second of sim time after it was sent
-        deadline = time.monotonic() + 10
-        while self.last_odom.twist.twist.linear.x < 0.1 and time.monotonic() < deadline:
-            time.sleep(0.01)
+        wait_until(lambda: self.last_odom.twist.twist.linear.x >= 0.1, 10,
+                   "/odom's linear.x to pass 0.1 m/s after a 0.6 m/s command", interval=0.01)
         wait_until_sim_time(rospy.get_time() + 1.0)
         odom = self.last_odom
         self.cmd.publish(Twist())
@@ -149,9 +145,8 @@ class DriveTest(unittest.TestCase):
         tf_sub = rospy.Subscriber("/tf", TFMessage, lambda m: transforms.extend(m.transforms))
         # Under load a new subscriber may connect a second after another: count from the
         # moment both topics have delivered, so a late connection is not read as a lost message.
-        deadline = time.monotonic() + 10
-        while not (odometry and transforms) and time.monotonic() < deadline:
-            time.sleep(0.01)
+        wait_until(lambda: odometry and transforms, 10, "a first /odom and /tf message",
+                   interval=0.01)
         command = Twist()
         command.linear.x, command.angular.z = 0.3, 0.2
         self.cmd.publish(command)
