@@ -64,7 +64,7 @@ def install(report=True):
     tracker.pending_writes = pending_writes
 
     def after_fork():
-        """A warm interpreter's child (m2wr_tools.zygote): nothing of its parent's threads,
+        """A warm interpreter's child (m2wr_tools.running.zygote): nothing of its parent's threads,
         calls, connections or report publisher is its own."""
         global _publisher
         _publisher = None
