@@ -25,9 +25,11 @@ NO_NEARER = 0.2                # [m] a path that never came this much nearer its
 AWAY = 120.0                   # [deg] off the goal's bearing at the end: facing away
 TURN_STEP = 0.1                # [s] sim: turns_in_place looks at the track this often
 IN_PLACE = 0.05                # [m/s] slower than this, a turning robot turns on the spot
-TURNING = 0.2                  # [rad/s] turning at least this fast
+TURNING = 0.5                  # [rad/s] turning faster than this: a go to point's turn (the
+                               # series' turns at 0.7 rad/s; its wall follower's at 0.3, either
+                               # way of the goal, is left out)
 BAND = (15.0, 165.0)           # [deg] off the goal's bearing: a turn there has a side
-TURNED_AWAY = 90.0             # [deg] turned away on the spot, at least, ...
+TURNED_AWAY = 30.0             # [deg] turned away on the spot, at least, ...
 AWAY_SHARE = 0.8               # ... and this share of its turns on the spot with a side
 
 
@@ -85,7 +87,7 @@ def _wrap(angle):
 
 def turns_in_place(track, goal):
     """(degrees turned away from the goal, degrees turned toward it) while the robot turned on
-    the spot (slower than IN_PLACE, turning faster than TURNING), counted where the goal was
+    the spot fast (slower than IN_PLACE, turning faster than TURNING), counted where the goal was
     between BAND[0] and BAND[1] deg off its heading (facing the goal or right away from it, a
     turn has no side), from `track`: rows (sim time [s], x, y, yaw [rad]), every TURN_STEP s.
     A go to point turns toward its goal; written for the other turning convention, it turns
