@@ -416,3 +416,45 @@ def test_a_goal_run_that_turned_away_is_told_so():
     near = dict(away, path=[[0, 0.0, 8.0], [5, 1.5, 8.0]], final_x=1.0)
     assert scoring.goal_hint(near, (2.0, 8.0), True) == "came within 0.50 m of it, ended " \
         "1.00 m away"
+
+
+def _spin(track, t, x, y, yaw, rate, seconds):
+    """`track` extended by a turn on the spot at (x, y) from `yaw`, `rate` [rad/s], 20 Hz."""
+    for i in range(1, int(seconds * 20) + 1):
+        track.append((t + i / 20.0, x, y, yaw + rate * i / 20.0))
+    return t + seconds, yaw + rate * seconds
+
+
+def test_a_bug_run_that_turns_away_on_the_spot_is_told_so():
+    # a bug program's go to point under the other convention, switched on at (0, 8) facing
+    # east with its goal south: on the spot it turns left (away), each time it is switched
+    # on; between two switchings the wall follower takes it a few metres
+    goal = (0.0, -3.0)
+    track = [(0.0, 0.0, 8.0, 0.0)]
+    t, yaw = _spin(track, 0.0, 0.0, 8.0, 0.0, 0.7, 2.2)            # -90 deg off -> -180
+    for i in range(1, 41):                                          # wall following, 2 m
+        track.append((t + i / 10.0, 0.0, 8.0 - 0.05 * i, -1.2))
+    t, yaw = _spin(track, t + 4.0, 0.0, 6.0, -1.2, 0.7, 2.0)        # -21 deg off -> -101
+    away, toward = scoring.turns_in_place(track, goal)
+    assert toward == 0.0 and 145 < away < 165, (away, toward)
+    record = {"x": 0.0, "y": 8.0, "path": [[r[0], r[1], r[2]] for r in track[::10]],
+              "final_x": 0.0, "final_y": 6.0, "final_yaw": yaw}
+    hint = scoring.goal_hint(record, goal, False, turns=(away, toward))
+    assert hint.startswith("turned away from the goal: on the spot it turned %.0f deg away "
+                           "from the goal's direction and 0 deg toward it" % away), hint
+    assert hint.endswith("as a program written for the other turning convention does (this "
+                         "task: legacy_mode false)"), hint
+    # the same program under its own convention turns toward the goal: no such hint
+    track = [(0.0, 0.0, 8.0, 0.0)]
+    _spin(track, 0.0, 0.0, 8.0, 0.0, -0.7, 2.2)
+    away, toward = scoring.turns_in_place(track, goal)
+    assert away == 0.0 and toward > 60, (away, toward)
+    assert not scoring.goal_hint(dict(record, final_yaw=-1.57), goal, True,
+                                 turns=(away, toward)).startswith("turned away")
+    # driving (not on the spot) and turning while facing the goal or right away from it
+    # count for neither side
+    assert scoring.turns_in_place([(0.0, 0.0, 8.0, 0.0), (0.1, 0.06, 8.0, 0.1),
+                                   (0.2, 0.12, 8.0, 0.2)], goal) == (0.0, 0.0)
+    track = [(0.0, 0.0, 8.0, 1.571)]
+    _spin(track, 0.0, 0.0, 8.0, 1.571, 0.7, 0.2)
+    assert scoring.turns_in_place(track, goal) == (0.0, 0.0)

@@ -21,7 +21,9 @@ What GradeRig adds to a run:
            group); the simulator's call log read from where the run began; findings judged:
            a rule broken or the memory limit passed fails the run with that reason
 The record gets: student, task, index, legacy_mode, left_out (what the launch files lost:
-file, element, why), after_start (what each step did, in words), findings (each rule
+file, element, why), after_start (what each step did, in words), turned_in_place_deg (a goal
+run's turns on the spot, [away from the goal, toward it], scoring.turns_in_place; a missed
+goal's reason says "turned away from the goal" from them), findings (each rule
 finding), user, isolated, memory_peak_mib, leftovers (processes that outlived the controller's stop), grader_s (the
 wall time of what the grader adds around the batch runner's run: files in and out, the end).
 """
@@ -139,14 +141,31 @@ class GradeRig(Rig):
                       findings=current.findings, memory_peak_mib=current.peak_mib,
                       memory_over=current.watchdog.seen if current.watchdog else "",
                       leftovers=current.leftovers)
+        turns = None
+        if scenario.task.kind == "goal" and "path" in record:
+            turns = self._turns_in_place(scenario)
+            if turns is not None:       # [deg] on the spot, away from the goal and toward it
+                record["turned_in_place_deg"] = list(turns)
         broken = current.watchdog_finding or rules.verdict(current.findings)
         if broken:
             record.update(success=False, reason=broken)
         elif not record.get("success") and scenario.task.kind == "goal" and "path" in record:
-            hint = scoring.goal_hint(record, scenario.task.goal, scenario.legacy_mode)
+            hint = scoring.goal_hint(record, scenario.task.goal, scenario.legacy_mode,
+                                     turns=turns)
             if hint:
                 record["reason"] = "%s: %s" % (record.get("reason", ""), hint)
         return record
+
+    def _turns_in_place(self, scenario):
+        """scoring.turns_in_place of the run just measured (its whole track, [0, duration]
+        of sim time, as the recorder heard it), or None without one."""
+        poses = getattr(self.recorder, "poses", None)
+        if not poses:
+            return None
+        from pybullet_gazebo.engine.transforms import yaw_from_quaternion
+        track = [(p[0], p[1], p[2], yaw_from_quaternion(p[4:8])) for p in poses
+                 if 0.0 <= p[0] <= scenario.duration]
+        return scoring.turns_in_place(track, scenario.task.goal)
 
     def _resolve(self, argv):
         """`rosrun PKG EXE ARGS` as the executable's path in the student's packages (as

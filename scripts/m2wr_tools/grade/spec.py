@@ -18,7 +18,8 @@ field (the default, spec_default.yaml beside this file, says the same in its com
                           half the time 0.2-1.5 m from an obstacle)
     episode               the series' episode number (shown in the report)
     description           one line shown in the report
-    world                 world01 | world02 | world03 | a .world path (default world02)
+    world                 world01 | world02 | world03 | a .world path, absolute or relative
+                          to the spec's folder (default world02)
     starts                [[x, y, yaw], ...] [m, m, rad] start poses (default [[0, 8, 0]])
     seeds                 [0, ...] simulator seeds (laser noise); one run per start x seed
     duration              [s] of sim time a run lasts (default 60)
@@ -213,7 +214,7 @@ def parse(data, path="<spec>"):
         if not isinstance(task, _Located):
             fail(data.lines["tasks"], "task %d must be a mapping (name:, command:, kind:, ...)"
                  % number)
-        one = _task(task, defaults, number, fail)
+        one = _task(task, defaults, number, fail, path)
         if one.name in names:
             fail(task.lines["name"], "tasks[%d].name: '%s' is used twice; give each task its "
                  "own name" % (number, one.name))
@@ -243,7 +244,7 @@ def _number(value):
         and math.isfinite(value)
 
 
-def _task(task, defaults, number, fail):
+def _task(task, defaults, number, fail, path="<spec>"):
     merged, lines = dict(defaults), dict(getattr(defaults, "lines", {}))
     merged.update(task)
     lines.update(task.lines)
@@ -283,7 +284,12 @@ def _task(task, defaults, number, fail):
     if "world" in merged:
         if not isinstance(merged["world"], str) or not merged["world"].strip():
             bad("world", "must be a world name (world01, world02, world03) or a .world path")
-        values["world"] = merged["world"]
+        world = merged["world"]
+        if world.endswith(".world") and not os.path.isabs(world) and os.path.isfile(path):
+            # a .world path relative to the spec's folder (the default spec's bug 2 world)
+            world = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)),
+                                                  world))
+        values["world"] = world
     if "starts" in merged:
         starts = merged["starts"]
         if not isinstance(starts, list) or not starts or not all(
