@@ -28,7 +28,10 @@ PILLAR_WORLD = os.path.normpath(os.path.join(
     "pillar_on_the_line.world"))
 
 REAL_TIME_SPREAD = (0.65, 1.2)      # lockstep time / real-time time: lowest, highest allowed
-GOALS = [(-3.0, 7.0), (6.0, 6.5), (-6.0, 6.0)]     # from (0, 8) in world02
+# from (0, 8) facing east in world02: ahead and a little right, and back the way it faced.
+# (-3, 7) lies half-way to (-6, 6), on the same bearing (-161.6 deg): no case of its own
+# here; the rate test below drives to it in lockstep at 10, 20 and 50 Hz
+GOALS = [(6.0, 6.5), (-6.0, 6.0)]
 
 
 def series_runs(tmp_path, program, *args, timeout=900):

@@ -17,6 +17,7 @@ from sensor_msgs.msg import JointState
 
 from pybullet_gazebo.ros.testing import VirtualDisplay, wait_for_message
 
+HERE = os.path.dirname(os.path.abspath(__file__))        # rviz_probe.py sits beside this test
 LINKS = ("link_chassis", "link_left_wheel", "link_right_wheel", "sensor_laser")
 
 
@@ -38,7 +39,7 @@ class RvizRobotModelTest(unittest.TestCase):
         display = VirtualDisplay()
         try:
             probe = subprocess.run(
-                [sys.executable, os.path.join(package, "test", "rviz_probe.py"),
+                [sys.executable, os.path.join(HERE, "rviz_probe.py"),
                  os.path.join(package, "rviz", "m2wr.rviz"), "--seconds", "30",
                  "--settle", "3", "--screenshot", screenshot],
                 env=dict(os.environ, DISPLAY=display.display), capture_output=True,
