@@ -186,11 +186,11 @@ tasks:
         request: "data: true"
         if_offered: true
   - name: ep9_bug1
-    command: roslaunch motion_plan bug1.launch initial_x:=0 initial_y:=0 des_x:=7 des_y:=0
+    command: roslaunch motion_plan bug1.launch initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
     kind: goal
     world: {pillar}
-    starts: [[0, 0, 0]]
-    goal: [7, 0]
+    starts: [[3.5, -3.5, 0]]
+    goal: [3.5, 3.5]
     duration: 90
     points: 15
     allow: [set_model_state_to_start]
@@ -227,7 +227,9 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     turning) scores go to point, wall following and bug 1; noa's Noetic copy turns away from
     the goal, and the page says so. lee's bug1.launch starts a world and spawns m2wr: that
     part is left out, her page says what and why, and her run is kim's to the bit (the
-    grader's world was not touched). With legacy_mode false, the other way round."""
+    grader's world was not touched). With legacy_mode false, the other way round. Bug 1 goes
+    round a pillar on its line (from (3.5, -3.5), placed facing east, to (3.5, 3.5)): under
+    the other convention its go to point turns away on the spot, and the reason says so."""
     rows, runs, output = _series_grades(tmp_path, True)
     scores = {s: [float(rows[s][t]) for t in ("ep6_go_to_point", "ep7_follow_wall",
                                               "ep9_bug1")] for s in rows}
@@ -257,6 +259,12 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     assert 'ep6_go_to_point</a>: did not reach the goal: turned away from the goal</div>' \
         in index
     assert 'title="did not reach the goal (2.00, 8.00) within 0.30 m: turned away' in index
+    # bug 1 (placed facing east, its goal north): noa's go to point turns away on the spot
+    assert runs["noa", "ep9_bug1"]["reason"].startswith(
+        "did not reach the goal (3.50, 3.50) within 0.30 m: turned away from the goal"), \
+        runs["noa", "ep9_bug1"]["reason"]
+    assert runs["noa", "ep9_bug1"]["reason"].endswith("(this task: legacy_mode true)")
+    assert 'ep9_bug1</a>: did not reach the goal: turned away from the goal</div>' in index
 
     rows, runs, output = _series_grades(tmp_path, False)
     scores = {s: [float(rows[s][t]) for t in ("ep6_go_to_point", "ep7_follow_wall",
@@ -265,4 +273,8 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     assert scores["kim"][0] == 0.0 and scores["kim"][2] == 0.0, rows["kim"]
     assert runs["kim", "ep6_go_to_point"]["reason"].startswith(
         "did not reach the goal (2.00, 8.00) within 0.30 m: turned away from the goal")
+    assert runs["kim", "ep9_bug1"]["reason"].startswith(
+        "did not reach the goal (3.50, 3.50) within 0.30 m: turned away from the goal"), \
+        runs["kim", "ep9_bug1"]["reason"]
+    assert runs["kim", "ep9_bug1"]["reason"].endswith("(this task: legacy_mode false)")
     assert "Turning: <b>legacy_mode false" in (output / "index.html").read_text()
