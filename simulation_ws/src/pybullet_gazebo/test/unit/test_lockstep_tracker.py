@@ -157,7 +157,16 @@ def test_nothing_is_sent_while_the_simulator_does_not_listen():
     tracker.call_answered("/s", 1)
     tracker.call_ended(1)
     assert reports == [] and tracker.done()
-    assert tracker.report_now()["called"] == []     # nothing kept for no one
+    # a call is kept for the simulator that connects later: it waits for word of it
+    assert tracker.report_now()["called"] == [("/s", 1)]
+
+
+def test_the_first_clock_that_sets_a_sleepers_wake_up_is_news():
+    tracker, reports = make()
+    tracker.sleep_started(tid=7, start=0, duration=50 * MS)      # sim time not set yet
+    tracker.callback_started()
+    tracker.callback_ended(*CLOCK, count=1, now=5000 * MS)       # the first /clock
+    assert reports and reports[-1]["next_wake"] == 5050 * MS
 
 
 def test_a_report_names_the_earliest_wake_up_of_its_sleepers():

@@ -124,10 +124,12 @@ class Tracker:
             self._last[tid] = _OTHER
 
     def call_answered(self, service, port):
+        # kept even before the simulator listens (a program that calls a service as it
+        # starts): the simulator waits for its client's word on a call it answered
         with self._lock:
-            if self.reporting():
-                self._called.append((service, port))
-                self._news = True
+            self._called.append((service, port))
+            del self._called[:-KEEP_ANSWERED]
+            self._news = True
 
     def call_ended(self, tid):
         if self.counting_only:
@@ -268,12 +270,14 @@ class Tracker:
         return not (self._running or self._calls or self._due or self.pending_writes())
 
     def _wake_sleepers(self, now):
-        """Marks due the sleepers whose time has come; True if there were any."""
+        """Marks due the sleepers whose time has come; True if there were any, or if a
+        sleeper's wake-up became known (the first /clock: next_wake changes)."""
         woke = False
         for tid, (start, wake, duration) in list(self._sleeping.items()):
             if wake is None:
                 if now:
                     self._sleeping[tid] = (now, now + duration, duration)
+                    woke = True
             elif now >= wake or now < start:
                 self._due.add(tid)
                 woke = True
