@@ -174,3 +174,11 @@ def test_a_closed_connection_is_not_waited_for():
     own.written[("/scan", "/ctl", 9)] = 1
     board.take("/ctl", 2, 1, taken={("/scan", SIM, 9): 1}, written={})
     assert board.busy({"/ctl"}) is None
+
+
+def test_a_watchers_calls_are_not_waited_for():
+    answered = [("/gazebo/get_model_state", 7, "/recorder")]
+    board = Board(SIM, Own(), own_answered=lambda: [answered.pop()] if answered else [])
+    board.take("/recorder", 1, 1, taken={}, written={}, watcher=True)
+    assert not board.pending_calls({"/recorder"})
+    assert board.busy({"/recorder"}) is None

@@ -151,7 +151,7 @@ class Board:
                 if why is not None:
                     return why
             for (service, port), client in list(self._answered.items()):
-                if client in self.silent:
+                if client in self.silent or self._watcher(client):
                     self._answered.pop((service, port), None)
                 elif client in nodes:   # (kept for a client that is not a controller yet)
                     return client, "no word yet since the simulator answered its %s" % service
@@ -174,7 +174,12 @@ class Board:
         """Whether a call of one of `nodes` to the simulator awaits its client's report."""
         with self._changed:
             self._absorb_answered()
-            return any(client in nodes for client in self._answered.values())
+            return any(client in nodes and not self._watcher(client)
+                       for client in self._answered.values())
+
+    def _watcher(self, node):
+        report = self._reports.get(node)
+        return report is not None and report.watcher
 
     def _not_done(self, node, nodes, taken_own, written_own, inbound):
         """(node, why) if `node`'s report does not yet cover what it was sent, else None."""
