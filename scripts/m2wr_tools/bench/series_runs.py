@@ -151,7 +151,10 @@ def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
     session.master().setParam("/series_runs", gazebo_calls.PARAM, call_log)
     session.launch_world(run.world, real_time_factor=0.0 if lockstep else 1.0,
                          lockstep=lockstep, paused=True, pub_clock_frequency=run.clock_hz,
-                         contacts=True, extra=("legacy_mode:=true",))
+                         contacts=True, extra=("legacy_mode:=true",),
+                         # as the batch runner: a loaded machine may starve a controller
+                         # past the default 1 s, and a step past would make runs differ
+                         lockstep_timeout=30.0)
     try:
         session.wait_for_simulator()
         session.spawn(*run.start)

@@ -64,10 +64,7 @@ def test_go_to_point_reaches_its_goal_in_lockstep_as_at_real_time(tmp_path, goal
         (lockstep["time_to_goal_s"], times)
 
 
-@pytest.mark.parametrize("rate", [10, 20, pytest.param(50, marks=pytest.mark.xfail(
-    reason="known defect, 28 Nov: with the handshake, two lockstep runs of the 50 Hz loop "
-           "differed once (a stop's last run); to be found and fixed (issue 36)",
-    strict=False))])
+@pytest.mark.parametrize("rate", [10, 20, 50])
 def test_two_lockstep_runs_are_identical_at_any_loop_rate(tmp_path, rate):
     first, second = series_runs(tmp_path, "go_to_point", "--goal", -3, 7, "--rate", rate,
                                 "--modes", "lockstep", "--repeat", 2)

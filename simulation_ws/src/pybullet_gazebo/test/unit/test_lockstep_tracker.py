@@ -2,6 +2,7 @@
 what its reports say (pybullet_gazebo/ros/lockstep/tracker.py)."""
 import threading
 import time
+import warnings
 
 from pybullet_gazebo.ros.lockstep.tracker import Tracker
 
@@ -141,6 +142,48 @@ def test_a_due_thread_that_waits_for_the_wall_clock_is_not_waited_for():
     assert tracker.done()
 
 
+def test_a_sleeper_that_runs_before_its_ticks_callback_ends_is_due_until_it_sleeps():
+    """rospy wakes a sleeper inside the /clock callback: the loop may leave rospy.sleep
+    (and the sleepers' list) before that callback's end is told. It is at work all the
+    same; its report, once it sleeps again, names its next wake-up."""
+    tracker, reports = make()
+    tracker.sleep_started(tid=7, start=1000 * MS, duration=50 * MS)
+    tracker.callback_started()
+    tracker.sleep_ended(7)                          # the loop runs first ...
+    tracker.callback_ended(*CLOCK, count=1, now=1050 * MS)     # ... then the callback ends
+    assert not tracker.done() and reports == []
+    tracker.published(7)
+    tracker.wrote("/cmd_vel", "/gazebo", 40000)
+    tracker.unqueued()                              # its command leaves the queue
+    assert not tracker.done() and reports == []     # still at work
+    tracker.sleep_started(tid=7, start=1050 * MS, duration=50 * MS)
+    assert tracker.done() and len(reports) == 1
+    assert reports[0]["next_wake"] == 1100 * MS and reports[0]["taken"] == {CLOCK: 1}
+
+
+def test_time_sleep_zero_in_a_loop_thread_keeps_it_due():
+    """rospy's queued publish yields with time.sleep(0) after each message: a yield, not a
+    wait for the wall clock (the hook in rospy_hooks.py; taken for a wait, the loop looked
+    done while it was still at work, and two lockstep runs of a 50 Hz loop differed)."""
+    import rospy  # noqa: F401  (the project's environment wraps it as it is imported)
+    from pybullet_gazebo.ros.lockstep import rospy_hooks
+    tracker = rospy_hooks.TRACKER or rospy_hooks.install(report=False)
+    counting_only, tracker.counting_only = tracker.counting_only, False
+    tid = threading.get_ident()
+    try:
+        tracker.sleep_started(tid=tid, start=MS, duration=MS)
+        tracker.time_set(2 * MS)
+        tracker.sleep_ended(tid)
+        assert not tracker.done()
+        time.sleep(0)
+        assert not tracker.done()
+        time.sleep(0.001)
+        assert tracker.done()
+    finally:
+        tracker.counting_only = counting_only
+        tracker.forget_thread(tid)
+
+
 def test_dropped_messages_count_as_taken_in():
     tracker, reports = make()
     tracker.dropped(SCAN[0], SCAN[2], 2)        # queue_size=1 kept the newest of three
@@ -178,6 +221,8 @@ def test_a_report_names_the_earliest_wake_up_of_its_sleepers():
     assert reports[-1]["next_wake"] == 1020 * MS
     tracker.sleep_ended(7)
     tracker.sleep_ended(8)
+    tracker.wall_sleep(7)                          # both now wait for the wall clock
+    tracker.wall_sleep(8)
     tracker.callback_started()
     tracker.callback_ended(*SCAN, count=1)
     assert reports[-1]["next_wake"] == 0          # nobody sleeps on sim time
@@ -206,3 +251,35 @@ def test_a_wait_that_times_out_leaves_its_thread_not_due():
     tracker.cond_wait_ended(tid=1, condition=condition)          # timed out
     tracker.cond_notified(condition, 1)                          # nobody waits now
     assert tracker.done()
+
+
+def test_a_sim_time_sleep_counts_from_the_time_the_tracker_was_told():
+    """Ticks that come after a loop told the tracker it sleeps (and its process reported
+    done) but before it waits do not push its wake-up back: it wakes at the tick the
+    simulator waits for (rospy_hooks.sleep_on_sim_time; rospy's own sleep looks at the
+    clock again, and the run waited a time-out for a wake-up that never came)."""
+    import rospy
+    import rospy.rostime
+    from pybullet_gazebo.ros.lockstep.rospy_hooks import sleep_on_sim_time
+    def set_time(nsecs):                # as rospy's /clock callback does
+        with warnings.catch_warnings():             # (rospy calls notifyAll)
+            warnings.simplefilter("ignore", DeprecationWarning)
+            rospy.rostime._set_rostime(rospy.Time(1, nsecs))
+    saved = rospy.rostime._rostime_current, rospy.rostime._rostime_initialized
+    rospy.rostime.set_rostime_initialized(True)
+    try:
+        set_time(0)
+        told = rospy.rostime.get_rostime()           # what the tracker was told: 1.00 s
+        set_time(10 * MS)                            # a tick before the wait
+        woke = []
+        sleeper = threading.Thread(target=lambda: woke.append(
+            sleep_on_sim_time(told, rospy.Duration(0, 20 * MS)) or time.monotonic()))
+        sleeper.start()
+        time.sleep(0.05)
+        assert woke == []                            # 1.01 s: not yet
+        ticked = time.monotonic()
+        set_time(20 * MS)                            # its wake-up, 1.02 s
+        sleeper.join(2.0)
+        assert woke and woke[0] - ticked < 0.2       # at once, not at 1.03 s nor 0.5 s later
+    finally:
+        rospy.rostime._rostime_current, rospy.rostime._rostime_initialized = saved

@@ -165,9 +165,10 @@ def install(report=True):
         if length <= 0:
             return sleep(duration)
         tid = get_ident()
-        tracker.sleep_started(tid, rospy.rostime.get_rostime().to_nsec(), length)
+        initial = rospy.rostime.get_rostime()
+        tracker.sleep_started(tid, initial.to_nsec(), length)
         try:
-            return sleep(duration)
+            return sleep_on_sim_time(initial, duration)
         finally:
             tracker.sleep_ended(tid)
     rospy.timer.sleep = rospy.sleep = tracked_sleep
@@ -175,7 +176,10 @@ def install(report=True):
     wall_sleep = time.sleep
 
     def noted_wall_sleep(seconds):
-        tracker.wall_sleep(get_ident())
+        # time.sleep(0) only yields the processor (rospy's queued publish does it after
+        # every message): the thread is still at work
+        if seconds > 0:
+            tracker.wall_sleep(get_ident())
         return wall_sleep(seconds)
     time.sleep = noted_wall_sleep
 
@@ -258,6 +262,35 @@ def install(report=True):
         return result
     rospy.init_node = rospy.client.init_node = reporting_init_node
     return tracker
+
+
+def sleep_on_sim_time(initial, duration):
+    """rospy.timer.sleep on sim time from `initial`, the same but for two things, each
+    of which held lockstep runs for a time-out and made them differ:
+      - it counts from the time the tracker was told (`initial`), not from a second
+        look at the clock: once told, the process may report done, and ticks may come
+        before this thread waits; counted from a later tick, it would sleep past the
+        wake-up the simulator waits for;
+      - the time is tested under the time condition's lock: rospy tests it outside,
+        and a tick that comes between its test and its wait is lost to the sleeper
+        until the wait's 0.5 s (wall) run out (at real time the next tick wakes it,
+        one tick late; in lockstep there is no next tick until the loop is done)."""
+    import genpy
+    import rospy
+    get_rostime = rospy.rostime.get_rostime
+    condition = rospy.rostime.get_rostime_cond()
+    with condition:
+        while initial == genpy.Time(0) and not rospy.core.is_shutdown():
+            condition.wait(0.3)                 # sim time not set yet
+            initial = get_rostime()
+        wake = initial + duration
+        while initial <= get_rostime() < wake and not rospy.core.is_shutdown():
+            condition.wait(0.5)
+        now = get_rostime()
+    if now < initial:
+        raise rospy.exceptions.ROSTimeMovedBackwardsException((initial - now).to_sec())
+    if rospy.core.is_shutdown():
+        raise rospy.exceptions.ROSInterruptException("ROS shutdown request")
 
 
 def proc_watch_instead():

@@ -207,8 +207,16 @@ class Tracker:
             self._after_change()
 
     def sleep_ended(self, tid):
+        """Thread `tid` is back from rospy.sleep: at work until it sleeps, polls or waits
+        again. Marked here as well as by the /clock callback's end (`callback_ended`): rospy
+        wakes the sleeper inside that callback, and the sleeper may run, and leave the
+        sleepers' list, before the callback returns; had only the callback's end marked it,
+        the process would have looked done (the next tick sent) while its loop was still at
+        work on this one."""
         with self._lock:
-            self._sleeping.pop(tid, None)
+            if self._sleeping.pop(tid, None) is not None:
+                self._due.add(tid)
+                self._news = True           # its wake-up is gone from the next report
 
     def time_set(self, now):
         """Sim time is `now` [ns] (for a /clock message read outside a callback)."""
