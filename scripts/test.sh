@@ -38,38 +38,22 @@ python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib --junit
   --ignore="$ROOT/scripts/test/integration" "${unit_dirs[@]}" || status=1
 
 if [ "$mode" != "--unit" ]; then
-  # The rostests run at real time (mostly idle cores) and the integration tests mostly in
-  # lockstep (CPU-bound, their outcome load-independent): side by side they share this
-  # 2-core machine's time instead of adding up (docs/performance.md#test-suite).
-  run_rostests() {
-    for ws in simulation_ws catkin_ws; do
-      echo "[rostest] suites of $ws (catkin_make run_tests, two at a time)"
-      source_ws() { source "$ROOT/$ws/devel/setup.bash"; }   # without this script's arguments
-      set +u; source_ws; set -u
-      export PATH="$ROOT/.venv/bin:$PATH"
-      (cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j2 2>&1) > "$RESULTS/$ws-run_tests.log"
-      # one line per suite; the full output stays in the log
-      grep -E "^\[ROSTEST\]|^ *\[.*\]\[(passed|FAILURE|ERROR)\]|^ \* RESULT" \
-        "$RESULTS/$ws-run_tests.log" | sed 's/^/    /'
-      cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
-    done
-  }
-  set -m                                   # its own process group: stopped as one on Ctrl-C
-  run_rostests > "$RESULTS/rostest-progress.log" 2>&1 &
-  rostest_pid=$!
-  set +m
-  stop_rostests() { kill -- "-$rostest_pid" 2>/dev/null; }
-  trap 'stop_rostests; echo; echo "[test] interrupted: the rostests were stopped"; exit 130' INT TERM
-  echo "[test] rostest suites of both workspaces: in the background (pid $rostest_pid; log: test_results/rostest-progress.log)"
-  echo "[test] integration tests beside them (pytest, two at a time: batches on a real Dask cluster, lockstep, grading, the browser)"
-  python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib -n 2 \
+  for ws in simulation_ws catkin_ws; do
+    echo "[test] rostest suites of $ws (catkin_make run_tests, one at a time)"
+    source_ws() { source "$ROOT/$ws/devel/setup.bash"; }   # without this script's arguments
+    set +u; source_ws; set -u
+    export PATH="$ROOT/.venv/bin:$PATH"
+    (cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 2>&1) > "$RESULTS/$ws-run_tests.log"
+    # one progress line per suite; the full output stays in the log
+    grep -E "^-- run_tests.py: execute|^\[ROSTEST\]|^ *\[.*\]\[(passed|FAILURE|ERROR)\]|^SUMMARY|^ \* RESULT" \
+      "$RESULTS/$ws-run_tests.log" | sed 's/^/    /'
+    cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
+  done
+  set +u; source "$ROOT/scripts/env.sh"; set -u
+  echo "[test] batch runner (pytest: scripts/evaluate.sh on a real Dask scheduler and workers)"
+  python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib \
     --basetemp="$RESULTS/batch-tmp" --junitxml="$RESULTS/pytest-batch.xml" \
     "$ROOT/scripts/test/integration" || status=1
-  echo "[test] waiting for the rostest suites"
-  wait "$rostest_pid" || true
-  trap - INT TERM
-  cat "$RESULTS/rostest-progress.log"
-  set +u; source "$ROOT/scripts/env.sh"; set -u
 fi
 
 python "$ROOT/scripts/summarize_test_results.py" "$RESULTS" || status=1
