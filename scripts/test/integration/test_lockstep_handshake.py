@@ -19,9 +19,12 @@ SECONDS = 8.0                # [s] sim
 
 
 def run(log_dir, *options):
-    done = subprocess.run([sys.executable, RUN, str(log_dir), "--seconds", str(SECONDS)]
-                          + list(options), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                          text=True, timeout=300, stdin=subprocess.DEVNULL)
+    # a loaded machine may hold a starting controller past the default 1 s: stepped past,
+    # it would make the two runs differ (the batch runner waits 30 s too)
+    done = subprocess.run([sys.executable, RUN, str(log_dir), "--seconds", str(SECONDS),
+                           "--lockstep-timeout", "30"] + list(options),
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          timeout=300, stdin=subprocess.DEVNULL)
     assert done.returncode == 0, done.stdout
     return json.loads(done.stdout.strip().splitlines()[-1])
 
