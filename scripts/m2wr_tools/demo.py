@@ -183,7 +183,11 @@ def analyse(args, data, paths):
     from .analysis.scene import Scene
     from pybullet_gazebo.engine.transforms import Pose
 
-    recorder, start, end = data["recorder"], data["start"], data["end"]
+    recorder, start = data["recorder"], data["start"]
+    # the run's first --duration seconds: the recorder pauses physics on wall time, a few
+    # steps past that, as many as the machine's speed lets through; cut there, the figures
+    # of two lockstep runs are the same
+    end = min(data["end"], start + args.duration)
     scene = Scene.of_world(args.world, data["urdf"])
     try:
         scene.set_model_poses({n: p for n, p in data["poses"].items() if n != scene.robot_name})
