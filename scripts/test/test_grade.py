@@ -58,6 +58,26 @@ def test_the_default_spec_covers_episodes_5_to_10():
     assert all("set_model_state_to_start" in t.allow for t in spec.tasks if "bug" in t.name)
 
 
+def test_the_benchmark_class_bug2_launch_takes_the_default_specs_start_and_goal(tmp_path):
+    """The grader's benchmark class hands in a bug2.launch: the default spec's ep10 command
+    starts it with initial_x/initial_y and des_x/des_y, and its params are those (roslaunch
+    refuses an argument the file does not declare)."""
+    from m2wr_tools.bench import grade as grade_bench
+    task, = [t for t in load(DEFAULT_SPEC).tasks if t.name == "ep10_bug2"]
+    words = list(task.command)
+    assert words[:3] == ["roslaunch", "motion_plan", "bug2.launch"]
+    launch = tmp_path / "bug2.launch"
+    launch.write_text(grade_bench.BUG2_LAUNCH)
+    dumped = subprocess.run(["roslaunch", "--dump-params", str(launch)] + words[3:],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            timeout=60, stdin=subprocess.DEVNULL)
+    assert dumped.returncode == 0, dumped.stdout
+    params = dict(line.split(": ", 1) for line in dumped.stdout.splitlines() if ": " in line)
+    x, y, _ = task.starts[0]
+    assert (float(params["/initial_x"]), float(params["/initial_y"])) == (x, y)
+    assert (float(params["/des_pos_x"]), float(params["/des_pos_y"])) == tuple(task.goal)
+
+
 @pytest.mark.parametrize("change, message", [
     (("kind: wander", "kind: dance"), "line 5: tasks[1].kind: 'dance' is not a task kind; "
                                       "use one of wander, goal, wall"),

@@ -59,10 +59,12 @@ PACKAGE_XML = """<?xml version="1.0"?>
 """
 BUG2_LAUNCH = """<?xml version="1.0"?>
 <launch>
+  <arg name="initial_x" default="0"/>
+  <arg name="initial_y" default="8"/>
   <arg name="des_x" default="0"/>
   <arg name="des_y" default="-4"/>
-  <param name="initial_x" value="0"/>
-  <param name="initial_y" value="8"/>
+  <param name="initial_x" value="$(arg initial_x)"/>
+  <param name="initial_y" value="$(arg initial_y)"/>
   <param name="des_pos_x" value="$(arg des_x)"/>
   <param name="des_pos_y" value="$(arg des_y)"/>
   <node pkg="motion_plan" type="go_to_point.py" name="go_to_point" output="screen">
