@@ -229,7 +229,9 @@ def analyse(args, data, paths):
         cases=summary.case_durations(recorder.cases, start, end), picture=paths["picture"],
         bag=paths["bag"] if args.bag else "", replay=replay)
     end_pose = data["poses"].get(scene.robot_name)
-    if end_pose is not None:
+    if len(track):                  # where the reported run ends (its last recorded pose)
+        result.end = (float(track[-1, 1]), float(track[-1, 2]), float(yaws[-1]))
+    elif end_pose is not None:
         result.end = (float(end_pose.position[0]), float(end_pose.position[1]),
                       float(end_pose.rpy[2]))
     if nearest is not None and math.isfinite(nearest.distance):
