@@ -285,6 +285,10 @@ def main(argv=None):
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     if args.program != "follow_wall" and args.goal is None:
         parser.error("--goal X Y is needed for %s" % args.program)
+    if args.world.endswith(".world"):
+        # roslaunch runs the simulator from another folder: a path relative to the user's
+        # shell would not be found there
+        args.world = os.path.abspath(args.world)
     raise_on_signals()
     records = []
 

@@ -204,6 +204,17 @@ def test_nothing_is_sent_while_the_simulator_does_not_listen():
     assert tracker.report_now()["called"] == [("/s", 1)]
 
 
+def test_a_call_served_before_the_simulator_listens_is_in_the_report_it_gets_on_connecting():
+    # the series' bug 1 switches go to point on as both start: go to point may answer before
+    # the simulator has subscribed to its reports; bug 1's report names the call, so the
+    # simulator waits for go to point's word of it (it waited 30 s for it in a graded run)
+    tracker, reports = make(reporting=False)
+    tracker.handler_started()
+    tracker.handler_ended("/go_to_point_switch", 41000)
+    assert reports == [] and tracker.done()
+    assert tracker.report_now()["served"] == [("/go_to_point_switch", 41000)]
+
+
 def test_the_first_clock_that_sets_a_sleepers_wake_up_is_news():
     tracker, reports = make()
     tracker.sleep_started(tid=7, start=0, duration=50 * MS)      # sim time not set yet

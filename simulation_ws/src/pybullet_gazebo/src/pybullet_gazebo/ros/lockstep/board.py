@@ -24,6 +24,7 @@ import time
 
 CLOCK = "/clock"
 KEEP_CALLS = 4096          # unmatched service-call records kept (a client or server that died)
+KEEP_SEQS = 4096           # report numbers remembered per process, to know one sent twice
 
 
 class NodeReport:
@@ -35,11 +36,23 @@ class NodeReport:
         self.written = {}            # (topic, subscriber, port) -> count
         self.next_wake = 0           # [ns sim] its earliest sleeper's wake-up, 0: none
         self.watcher = False         # it said it only watches: never waited for
+        self._seqs = collections.deque(maxlen=KEEP_SEQS)     # the latest report numbers
+        self._seen = set()
 
     def merge(self, pid, seq, taken, written, next_wake=0, watcher=False):
-        """Totals only grow: a report older than one already merged changes nothing."""
+        """Totals only grow: a report older than one already merged changes nothing. False
+        for a report already taken (the same process and number): its service calls,
+        which are news once, were counted the first time."""
         if pid != self.pid:          # a new process under the node's name: start over
             self.pid, self.seq, self.taken, self.written = pid, 0, {}, {}
+            self._seqs.clear()
+            self._seen.clear()
+        if seq in self._seen:
+            return False
+        if len(self._seqs) == self._seqs.maxlen:
+            self._seen.discard(self._seqs[0])
+        self._seqs.append(seq)
+        self._seen.add(seq)
         if seq >= self.seq:
             self.next_wake = next_wake
         self.watcher = self.watcher or watcher
@@ -51,6 +64,7 @@ class NodeReport:
         for key, count in written.items():
             if count > self.written.get(key, 0):
                 self.written[key] = count
+        return True
 
 
 class Board:
@@ -82,8 +96,9 @@ class Board:
              watcher=False):
         """A report from `node` (its connection's callerid, never a field of the report)."""
         with self._changed:
-            self._reports.setdefault(node, NodeReport()).merge(pid, seq, taken, written,
-                                                               next_wake, watcher)
+            if not self._reports.setdefault(node, NodeReport()).merge(
+                    pid, seq, taken, written, next_wake, watcher):
+                return              # sent twice: a call it names would be waited for again
             for key in served:
                 if self._called.pop(key, None) is None:
                     self._remember(self._served, key, node)

@@ -368,9 +368,11 @@ def _peer_port(connection):
 
 
 def _open_publisher():
-    """The report publisher: latched, written in the reporting thread (no queue: a report
-    must leave before the thread goes on). A simulator that connects gets the counts as they
-    are at once."""
+    """The report publisher, written in the reporting thread (no queue: a report must leave
+    before the thread goes on). A simulator that connects gets the counts as they are at once
+    (or, if the process is at work, its next report); not latched: rospy would send the
+    latched report again after that one, and the service calls a report names are news
+    once."""
     global _publisher
     import warnings
 
@@ -386,7 +388,7 @@ def _open_publisher():
     with warnings.catch_warnings():          # rospy warns when queue_size is None: on purpose
         warnings.simplefilter("ignore", SyntaxWarning)
         _publisher = rospy.Publisher(REPORT_TOPIC, LockstepReport, queue_size=None,
-                                     latch=True, subscriber_listener=_OnConnect())
+                                     subscriber_listener=_OnConnect())
 
 
 def _reporting():
