@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Runs every test suite: scripts/setup.sh (if anything is missing), the fast unit tests with
-# pytest (no ROS master), then the rostest suites of both workspaces through catkin.
+# Runs every test suite: scripts/setup.sh (if anything is missing), then the rostest suites of
+# both workspaces through catkin in the background, beside the unit tests (pytest, no ROS
+# master) and then the integration tests (pytest: the batch runner, the grader, lockstep, the
+# browser view). Results and logs go to test_results/.
 # Exits non-zero when any test fails or a rostest crashed without writing its results, and
 # ends with one line `N passed, N failed, N skipped`.
 #
-#   scripts/test.sh            everything (unit, rostest, the batch runner's cluster tests)
+#   scripts/test.sh            everything (unit, rostest, integration)
 #   scripts/test.sh --unit     only the pytest unit tests
 #   scripts/test.sh --help     this text; sets up and runs nothing
 #
@@ -28,32 +30,70 @@ bash "$ROOT/scripts/setup.sh" || { echo "[test] setup failed; no test was run"; 
 set +u; source "$ROOT/scripts/env.sh"; set -u
 rm -rf "$RESULTS" && mkdir -p "$RESULTS"
 
+# The rostests run at real time: they wait on the wall clock far more than they compute. The
+# unit and batch tests are mostly lockstep runs, exact whatever the load, and compute all the
+# time. So the rostests run in the background beside them, and the computing side runs at a
+# lower priority (nice 10), so that the rostests' real-time simulators get the CPU when they
+# need it. (Two computing streams side by side do not pay on 2 cores, and the real-time
+# tests fail under that load.)
+run_rostests() {
+  for ws in simulation_ws catkin_ws; do
+    echo "[rostest] $ws (catkin_make run_tests, one at a time)"
+    (
+      set +u; source "$ROOT/$ws/devel/setup.bash"; set -u
+      export PATH="$ROOT/.venv/bin:$PATH"
+      cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 2>&1
+    ) > "$RESULTS/$ws-run_tests.log"
+    cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
+  done
+}
+# one progress line per suite; the full output stays in the logs
+rostest_lines() {
+  for ws in simulation_ws catkin_ws; do
+    [ -f "$RESULTS/$ws-run_tests.log" ] || continue
+    echo "[test] rostest suites of $ws (log: test_results/$ws-run_tests.log)"
+    grep -E "^-- run_tests.py: execute|^\[ROSTEST\]|^ *\[.*\]\[(passed|FAILURE|ERROR)\]|^SUMMARY|^ \* RESULT" \
+      "$RESULTS/$ws-run_tests.log" | sed 's/^/    /'
+  done
+}
+
 status=0
+rostest_pid=
+stop_rostests() {
+  if [ -n "$rostest_pid" ] && kill -0 "$rostest_pid" 2>/dev/null; then
+    kill -TERM -- "-$rostest_pid" 2>/dev/null
+    wait "$rostest_pid" 2>/dev/null
+  fi
+}
+trap 'stop_rostests; echo; echo "[test] interrupted: every process it started is stopped"; exit 130' INT TERM
+
+if [ "$mode" != "--unit" ]; then
+  echo "[test] rostest suites of both workspaces, in the background (started now)"
+  # its own process group (setsid), so that an interrupt stops all of it by its PID
+  setsid bash -c "$(declare -p ROOT RESULTS); $(declare -f run_rostests); run_rostests" \
+    > "$RESULTS/rostest-stream.log" 2>&1 < /dev/null &
+  rostest_pid=$!
+fi
+
 echo "[test] unit tests (pytest, no ROS master)"
 unit_dirs=()
 for d in "$ROOT"/simulation_ws/src/*/test/unit "$ROOT"/catkin_ws/src/*/test/unit "$ROOT/scripts/test"; do
   [ -d "$d" ] && unit_dirs+=("$d")
 done
-python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib --junitxml="$RESULTS/pytest-unit.xml" \
+nice -n 10 python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib --junitxml="$RESULTS/pytest-unit.xml" \
   --ignore="$ROOT/scripts/test/integration" "${unit_dirs[@]}" || status=1
 
 if [ "$mode" != "--unit" ]; then
-  for ws in simulation_ws catkin_ws; do
-    echo "[test] rostest suites of $ws (catkin_make run_tests, one at a time)"
-    source_ws() { source "$ROOT/$ws/devel/setup.bash"; }   # without this script's arguments
-    set +u; source_ws; set -u
-    export PATH="$ROOT/.venv/bin:$PATH"
-    (cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 2>&1) > "$RESULTS/$ws-run_tests.log"
-    # one progress line per suite; the full output stays in the log
-    grep -E "^-- run_tests.py: execute|^\[ROSTEST\]|^ *\[.*\]\[(passed|FAILURE|ERROR)\]|^SUMMARY|^ \* RESULT" \
-      "$RESULTS/$ws-run_tests.log" | sed 's/^/    /'
-    cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
-  done
-  set +u; source "$ROOT/scripts/env.sh"; set -u
-  echo "[test] batch runner (pytest: scripts/evaluate.sh on a real Dask scheduler and workers)"
-  python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib \
+  echo "[test] batch runner, grader, lockstep, browser (pytest: real Dask scheduler and workers, chromium)"
+  nice -n 10 python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib \
     --basetemp="$RESULTS/batch-tmp" --junitxml="$RESULTS/pytest-batch.xml" \
     "$ROOT/scripts/test/integration" || status=1
+  if kill -0 "$rostest_pid" 2>/dev/null; then
+    echo "[test] waiting for the rostest suites"
+  fi
+  wait "$rostest_pid" 2>/dev/null
+  rostest_pid=
+  rostest_lines
 fi
 
 python "$ROOT/scripts/summarize_test_results.py" "$RESULTS" || status=1

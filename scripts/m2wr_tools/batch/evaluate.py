@@ -110,6 +110,11 @@ def parse_args(argv):
                         help="wall seconds for the controller to publish cmd_vel")
     parser.add_argument("--run-timeout", type=float, default=0.0,
                         help="wall seconds a run may take (default: 60 + 2 x duration)")
+    parser.add_argument("--lockstep-timeout", type=float, default=30.0,
+                        help="wall seconds the simulator waits for a controller that is still "
+                        "at work before it steps on without it (the world launch's "
+                        "lockstep_timeout; default: 30, so that a loaded machine does not "
+                        "make a controller's answer late; the run summary counts each)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--bench", action="store_true", help="the batch benchmark (see above)")
     parser.add_argument("--bench-memory", action="store_true",
@@ -471,6 +476,7 @@ def evaluate(args):
     options = RunOptions(output=args.output, reuse=not args.no_reuse, bag=args.bag,
                          picture=args.pictures, replay=args.replays,
                          connect_timeout=args.connect_timeout,
+                         lockstep_timeout=args.lockstep_timeout,
                          run_timeout=args.run_timeout, warm_start=not args.cold_start)
     records = run_batch(scenarios, options, scheduler=args.scheduler, workers=args.workers,
                         resume=not args.fresh, progress=not args.no_progress, say=say)

@@ -1,6 +1,7 @@
 """scripts/evaluate.sh with controllers that fail: one that exits 1 at once and one that
 never publishes on /cmd_vel. Each run is marked failed with the reason and the controller's
 log, the batch finishes (exit 0, every run in the results) and no process is left."""
+import glob
 import os
 
 from m2wr_tools.paths import ROOT
@@ -36,17 +37,23 @@ def test_crashing_and_silent_controllers_fail_their_runs_not_the_batch(tmp_path,
 
 def test_a_hung_controller_does_not_hold_the_simulator(tmp_path, run_evaluate,
                                                        no_process_left):
-    """Blocked for ever after its first answer, it is asleep: lockstep's barrier does not
-    wait for it, the run goes its full length and fails because the robot stood still."""
+    """Blocked for ever in its second callback: lockstep waits for it lockstep_timeout (3 s
+    here), steps on without it and says so; the run goes its full length and fails because
+    the robot stood still."""
     status, text, data = run_evaluate(
         ["--controller", os.path.join(FIXTURES, "hung_controller.py"), "--workers", "1",
-         "--duration", "10", "--run-timeout", "60"], tmp_path / "hung")
+         "--duration", "10", "--run-timeout", "60", "--lockstep-timeout", "3"],
+        tmp_path / "hung")
     assert status == 0, text
     [r] = data["runs"]
     assert r["success"] is False
     assert r["reason"].startswith("travelled 0.00 m, under the 1.00 m asked"), r["reason"]
     assert r["cmd_vel_messages"] >= 1            # it did answer once
     assert r["sim_time_s"] >= 9.9                # the whole run (its last step), not held
+    [world_log] = glob.glob(str(tmp_path / "hung" / "logs" / "*" / "world.log"))
+    with open(world_log) as log:
+        assert "lockstep: node /hung_controller (/m2wr/laser/scan not taken in: 0 of 1) was " \
+            "still at work 3.00 s after it was sent a message; stepping on" in log.read()
     no_process_left(data)
 
 
