@@ -35,7 +35,9 @@ rm -rf "$RESULTS" && mkdir -p "$RESULTS"
 # time. So the rostests run in the background beside them, and the computing side runs at a
 # lower priority (nice 10), so that the rostests' real-time simulators get the CPU when they
 # need it. (Two computing streams side by side do not pay on 2 cores, and the real-time
-# tests fail under that load.)
+# tests fail under that load.) The integration tests that compare lockstep with real-time runs
+# wait on the wall clock too: they follow the rostests in the background.
+WALL_BOUND="$ROOT/scripts/test/integration/test_series_lockstep_vs_real_time.py"
 run_rostests() {
   for ws in simulation_ws catkin_ws; do
     echo "[rostest] $ws (catkin_make run_tests, one at a time)"
@@ -46,6 +48,11 @@ run_rostests() {
     ) > "$RESULTS/$ws-run_tests.log"
     cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
   done
+  echo "[integration, real time] $WALL_BOUND"
+  python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib \
+    --basetemp="$RESULTS/wall-bound-tmp" --junitxml="$RESULTS/pytest-wall-bound.xml" \
+    "$WALL_BOUND" > "$RESULTS/pytest-wall-bound.log" 2>&1
+  echo $? > "$RESULTS/pytest-wall-bound.status"
 }
 # one progress line per suite; the full output stays in the logs
 rostest_lines() {
@@ -68,9 +75,9 @@ stop_rostests() {
 trap 'stop_rostests; echo; echo "[test] interrupted: every process it started is stopped"; exit 130' INT TERM
 
 if [ "$mode" != "--unit" ]; then
-  echo "[test] rostest suites of both workspaces, in the background (started now)"
+  echo "[test] rostest suites of both workspaces, then $(basename "$WALL_BOUND"), in the background (started now)"
   # its own process group (setsid), so that an interrupt stops all of it by its PID
-  setsid bash -c "$(declare -p ROOT RESULTS); $(declare -f run_rostests); run_rostests" \
+  setsid bash -c "$(declare -p ROOT RESULTS WALL_BOUND); $(declare -f run_rostests); run_rostests" \
     > "$RESULTS/rostest-stream.log" 2>&1 < /dev/null &
   rostest_pid=$!
 fi
@@ -87,13 +94,16 @@ if [ "$mode" != "--unit" ]; then
   echo "[test] batch runner, grader, lockstep, browser (pytest: real Dask scheduler and workers, chromium)"
   nice -n 10 python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib \
     --basetemp="$RESULTS/batch-tmp" --junitxml="$RESULTS/pytest-batch.xml" \
-    "$ROOT/scripts/test/integration" || status=1
+    --ignore="$WALL_BOUND" "$ROOT/scripts/test/integration" || status=1
   if kill -0 "$rostest_pid" 2>/dev/null; then
-    echo "[test] waiting for the rostest suites"
+    echo "[test] waiting for the background tests (rostests, real-time comparisons)"
   fi
   wait "$rostest_pid" 2>/dev/null
   rostest_pid=
   rostest_lines
+  echo "[test] $(basename "$WALL_BOUND") (log: test_results/pytest-wall-bound.log)"
+  tail -n 3 "$RESULTS/pytest-wall-bound.log" 2>/dev/null | sed 's/^/    /'
+  [ "$(cat "$RESULTS/pytest-wall-bound.status" 2>/dev/null)" = 0 ] || status=1
 fi
 
 python "$ROOT/scripts/summarize_test_results.py" "$RESULTS" || status=1
