@@ -31,7 +31,6 @@ from .names import (COMMAND_TOPIC, CONTROLLER_NODE, DEFAULT_START, DEFAULT_WORLD
                     PAUSE_SERVICE, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC, SIMULATOR_NODE,
                     UNPAUSE_SERVICE)
 from .paths import ROOT
-from .analysis.scene import SCAN_HEIGHT
 from .running.session import Session, SessionError
 from .tool_exit import exit_status
 from . import usage
@@ -180,7 +179,7 @@ def analyse(args, data, paths):
     """The offline part: clearance, picture, summary."""
     import numpy as np
     from .analysis import picture, replays
-    from .analysis.scene import Scene
+    from .analysis.scene import SCAN_HEIGHT, Scene   # (pybullet: not for --help)
     from pybullet_gazebo.engine.transforms import Pose
 
     recorder, start = data["recorder"], data["start"]
