@@ -294,3 +294,47 @@ def test_a_sim_time_sleep_counts_from_the_time_the_tracker_was_told():
         assert woke and woke[0] - ticked < 0.2       # at once, not at 1.03 s nor 0.5 s later
     finally:
         rospy.rostime._rostime_current, rospy.rostime._rostime_initialized = saved
+
+
+def test_a_sleep_begun_before_the_first_clock_counts_from_that_tick_as_the_tracker_does():
+    """rospy.sleep before sim time is set: the tracker counts it from the first /clock. A
+    second tick may come before the sleeper runs again (its process reported done with the
+    wake-up the tracker knows); counted from that one it would sleep past the wake-up the
+    simulator waits for."""
+    import rospy
+    import rospy.rostime
+    from pybullet_gazebo.ros.lockstep import rospy_hooks
+    def set_time(nsecs):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            rospy.rostime._set_rostime(rospy.Time(1, nsecs))
+    saved = (rospy.rostime._rostime_current, rospy.rostime._rostime_initialized,
+             rospy_hooks.TRACKER)
+    tracker, _ = make()
+    rospy_hooks.TRACKER = tracker
+    rospy.rostime.set_rostime_initialized(True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        rospy.rostime._set_rostime(rospy.Time(0))              # sim time not set yet
+    condition = rospy.rostime.get_rostime_cond()
+    try:
+        woke = []
+        sleeper = threading.Thread(target=lambda: woke.append(
+            rospy_hooks.sleep_on_sim_time(rospy.Time(0), rospy.Duration(0, 20 * MS))
+            or time.monotonic()))
+        with condition:                 # the sleeper sees no tick before the second one
+            sleeper.start()
+            tracker.sleep_started(sleeper.ident, 0, 20 * MS)
+            set_time(0)                                                # the first tick: 1.00 s
+            tracker.callback_started()
+            tracker.callback_ended(*CLOCK, count=1, now=1000 * MS)    # counted from 1.00 s
+            set_time(10 * MS)                                          # 1.01 s
+        time.sleep(0.05)
+        assert woke == []
+        ticked = time.monotonic()
+        set_time(20 * MS)                               # its wake-up, as the tracker has it
+        sleeper.join(2.0)
+        assert woke and woke[0] - ticked < 0.2          # not at 1.03 s, nor a time-out later
+    finally:
+        (rospy.rostime._rostime_current, rospy.rostime._rostime_initialized,
+         rospy_hooks.TRACKER) = saved

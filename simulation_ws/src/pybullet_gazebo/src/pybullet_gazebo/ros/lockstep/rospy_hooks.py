@@ -274,7 +274,10 @@ def sleep_on_sim_time(initial, duration):
       - the time is tested under the time condition's lock: rospy tests it outside,
         and a tick that comes between its test and its wait is lost to the sleeper
         until the wait's 0.5 s (wall) run out (at real time the next tick wakes it,
-        one tick late; in lockstep there is no next tick until the loop is done)."""
+        one tick late; in lockstep there is no next tick until the loop is done).
+    A sleep begun before the first /clock counts from that tick, as the tracker does: once
+    the tracker has it, the process may report done and more ticks may come before this
+    thread runs again."""
     import genpy
     import rospy
     get_rostime = rospy.rostime.get_rostime
@@ -282,7 +285,7 @@ def sleep_on_sim_time(initial, duration):
     with condition:
         while initial == genpy.Time(0) and not rospy.core.is_shutdown():
             condition.wait(0.3)                 # sim time not set yet
-            initial = get_rostime()
+            initial = _counted_from(get_rostime())
         wake = initial + duration
         while initial <= get_rostime() < wake and not rospy.core.is_shutdown():
             condition.wait(0.5)
@@ -291,6 +294,16 @@ def sleep_on_sim_time(initial, duration):
         raise rospy.exceptions.ROSTimeMovedBackwardsException((initial - now).to_sec())
     if rospy.core.is_shutdown():
         raise rospy.exceptions.ROSInterruptException("ROS shutdown request")
+
+
+def _counted_from(now):
+    """The first /clock's time, as this thread's sleep was counted from by the tracker (it
+    saw that tick first); `now` (the time after it) when the tracker has none."""
+    tracker = TRACKER
+    start = tracker.sleep_start(threading.get_ident()) if tracker is not None else None
+    if start is None or now.to_nsec() == start:
+        return now
+    return type(now)(start // 1000000000, start % 1000000000)
 
 
 def proc_watch_instead():

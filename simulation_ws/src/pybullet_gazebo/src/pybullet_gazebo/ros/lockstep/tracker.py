@@ -169,6 +169,13 @@ class Tracker:
             self._last[tid] = _OTHER
         self._after_change()
 
+    def sleep_start(self, tid):
+        """The sim time [ns] thread `tid`'s sleep counts from, once known: for a sleep begun
+        before the first /clock, that tick's time. None when not known (yet)."""
+        with self._lock:
+            start = self._sleeping.get(tid, (0,))[0]
+        return start or None
+
     def cond_wait_started(self, tid, condition):
         """Thread `tid` waits on a threading.Condition: done until it is notified."""
         if self.counting_only:
