@@ -38,7 +38,8 @@ rm -rf "$RESULTS" && mkdir -p "$RESULTS"
 # tests fail under that load.) The integration tests that compare lockstep with real-time runs
 # wait on the wall clock too: they follow the rostests in the background.
 WALL_BOUND="$ROOT/scripts/test/integration/test_series_lockstep_vs_real_time.py"
-run_rostests() {
+PYTEST=(python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib)
+run_background() {
   for ws in simulation_ws catkin_ws; do
     echo "[rostest] $ws (catkin_make run_tests, one at a time)"
     (
@@ -49,8 +50,7 @@ run_rostests() {
     cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
   done
   echo "[integration, real time] $WALL_BOUND"
-  python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib \
-    --basetemp="$RESULTS/wall-bound-tmp" --junitxml="$RESULTS/pytest-wall-bound.xml" \
+  "${PYTEST[@]}" --basetemp="$RESULTS/wall-bound-tmp" --junitxml="$RESULTS/pytest-wall-bound.xml" \
     "$WALL_BOUND" > "$RESULTS/pytest-wall-bound.log" 2>&1
   echo $? > "$RESULTS/pytest-wall-bound.status"
 }
@@ -65,21 +65,21 @@ rostest_lines() {
 }
 
 status=0
-rostest_pid=
-stop_rostests() {
-  if [ -n "$rostest_pid" ] && kill -0 "$rostest_pid" 2>/dev/null; then
-    kill -TERM -- "-$rostest_pid" 2>/dev/null
-    wait "$rostest_pid" 2>/dev/null
+background_pid=
+stop_background() {
+  if [ -n "$background_pid" ] && kill -0 "$background_pid" 2>/dev/null; then
+    kill -TERM -- "-$background_pid" 2>/dev/null
+    wait "$background_pid" 2>/dev/null
   fi
 }
-trap 'stop_rostests; echo; echo "[test] interrupted: every process it started is stopped"; exit 130' INT TERM
+trap 'stop_background; echo; echo "[test] interrupted: every process it started is stopped"; exit 130' INT TERM
 
 if [ "$mode" != "--unit" ]; then
   echo "[test] rostest suites of both workspaces, then $(basename "$WALL_BOUND"), in the background (started now)"
   # its own process group (setsid), so that an interrupt stops all of it by its PID
-  setsid bash -c "$(declare -p ROOT RESULTS WALL_BOUND); $(declare -f run_rostests); run_rostests" \
-    > "$RESULTS/rostest-stream.log" 2>&1 < /dev/null &
-  rostest_pid=$!
+  setsid bash -c "$(declare -p ROOT RESULTS WALL_BOUND PYTEST); $(declare -f run_background); run_background" \
+    > "$RESULTS/background.log" 2>&1 < /dev/null &
+  background_pid=$!
 fi
 
 echo "[test] unit tests (pytest, no ROS master)"
@@ -87,19 +87,18 @@ unit_dirs=()
 for d in "$ROOT"/simulation_ws/src/*/test/unit "$ROOT"/catkin_ws/src/*/test/unit "$ROOT/scripts/test"; do
   [ -d "$d" ] && unit_dirs+=("$d")
 done
-nice -n 10 python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib --junitxml="$RESULTS/pytest-unit.xml" \
+nice -n 10 "${PYTEST[@]}" --junitxml="$RESULTS/pytest-unit.xml" \
   --ignore="$ROOT/scripts/test/integration" "${unit_dirs[@]}" || status=1
 
 if [ "$mode" != "--unit" ]; then
   echo "[test] batch runner, grader, lockstep, browser (pytest: real Dask scheduler and workers, chromium)"
-  nice -n 10 python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib \
-    --basetemp="$RESULTS/batch-tmp" --junitxml="$RESULTS/pytest-batch.xml" \
+  nice -n 10 "${PYTEST[@]}" --basetemp="$RESULTS/batch-tmp" --junitxml="$RESULTS/pytest-batch.xml" \
     --ignore="$WALL_BOUND" "$ROOT/scripts/test/integration" || status=1
-  if kill -0 "$rostest_pid" 2>/dev/null; then
+  if kill -0 "$background_pid" 2>/dev/null; then
     echo "[test] waiting for the background tests (rostests, real-time comparisons)"
   fi
-  wait "$rostest_pid" 2>/dev/null
-  rostest_pid=
+  wait "$background_pid" 2>/dev/null
+  background_pid=
   rostest_lines
   echo "[test] $(basename "$WALL_BOUND") (log: test_results/pytest-wall-bound.log)"
   tail -n 3 "$RESULTS/pytest-wall-bound.log" 2>/dev/null | sed 's/^/    /'

@@ -301,9 +301,7 @@ def _counted_from(now):
     saw that tick first); `now` (the time after it) when the tracker has none."""
     tracker = TRACKER
     start = tracker.sleep_start(threading.get_ident()) if tracker is not None else None
-    if start is None or now.to_nsec() == start:
-        return now
-    return type(now)(start // 1000000000, start % 1000000000)
+    return now if start is None else type(now)(0, start)     # (genpy carries the seconds)
 
 
 def proc_watch_instead():
