@@ -157,7 +157,7 @@ def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
                          lockstep_timeout=30.0)
     try:
         session.wait_for_simulator()
-        session.spawn(*run.start)
+        session.spawn_in_process(*run.start)
         goal = run.goal or (0.0, 0.0)
         args = ["roslaunch", "--sigint-timeout=5", "motion_plan",
                 launch_file] + list(run.launch_args)

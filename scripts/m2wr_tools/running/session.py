@@ -8,6 +8,7 @@ ROS_LOG_DIR=<log_dir>/ros; the caller's own ROS_MASTER_URI is never used, so a m
 user runs is left alone. `stop()` ends the children (SIGINT, then SIGTERM, SIGKILL) and
 checks that no process of the session is left (`processes.leftovers`).
 """
+import math
 import os
 import re
 import sys
@@ -17,8 +18,9 @@ import uuid
 import xmlrpc.client
 
 from . import processes, stale_nodes
-from ..names import (COMMAND_TOPIC, CONTROLLER_NODE, SCAN_TOPIC, SIMULATOR_NODE, SPAWN_LAUNCH,
-                    SPAWN_NODE, SPAWN_SERVICE, TUTORIAL_CONTROLLER, WORLD_LAUNCH)
+from ..names import (COMMAND_TOPIC, CONTROLLER_NODE, ROBOT_DESCRIPTION_PARAM, SCAN_TOPIC,
+                     SIMULATOR_NODE, SPAWN_LAUNCH, SPAWN_NODE, SPAWN_SERVICE,
+                     TUTORIAL_CONTROLLER, WORLD_LAUNCH)
 
 
 class SessionError(RuntimeError):
@@ -35,6 +37,7 @@ class Session:
         self.env = None
         self.children = {}                      # name -> processes.Child, in start order
         self.stop_report = {}
+        self._urdf = None                       # m2wr's URDF, made once (spawn_in_process)
 
     # --- processes ----------------------------------------------------------------------
     def _start(self, name, argv):
@@ -152,6 +155,34 @@ class Session:
         SessionError with its output unless it exits 0 without a node dying."""
         self.start_spawn(x, y, yaw)
         self.finish_spawn(timeout)
+
+    def spawn_in_process(self, x, y, yaw, z=0.5, timeout=30.0):
+        """What spawn.launch does, from this process (its rospy node initialised on this
+        session's master): robot_description from the xacro, then one spawn_urdf_model call
+        for model m2wr at (x, y, z, yaw), as spawn_model makes it. For tools that spawn once a
+        run: spawn.launch starts three Python interpreters (roslaunch, xacro, spawn_model),
+        about 2 s. The URDF is made once a session. SessionError with the simulator's answer
+        when the spawn is refused."""
+        import rospy
+        from gazebo_msgs.srv import SpawnModel
+        from geometry_msgs.msg import Pose
+        from ..paths import robot_urdf
+        if self._urdf is None:
+            self._urdf = robot_urdf()
+        rospy.set_param(ROBOT_DESCRIPTION_PARAM, self._urdf)
+        pose = Pose()
+        pose.position.x, pose.position.y, pose.position.z = float(x), float(y), float(z)
+        pose.orientation.z, pose.orientation.w = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+        try:
+            rospy.wait_for_service(SPAWN_SERVICE, timeout=timeout)
+            answer = rospy.ServiceProxy(SPAWN_SERVICE, SpawnModel)(
+                "m2wr", self._urdf, "/", pose, "")
+        except (rospy.ROSException, rospy.ServiceException) as error:
+            raise SessionError("spawning m2wr at (%g, %g, yaw %g): %s on %s"
+                               % (x, y, yaw, error, SPAWN_SERVICE)) from None
+        if not answer.success:
+            raise SessionError("spawning m2wr at (%g, %g, yaw %g) was refused: %s"
+                               % (x, y, yaw, answer.status_message))
 
     def start_spawn(self, x, y, yaw):
         self._spawn_pose = (float(x), float(y), float(yaw))
