@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""rostest: with the simulation running free, many times faster than real time, this node
+"""rostest: with the simulation running at 6x real time (real_time_factor 6), this node
 first only watches (/clock and /joint_states): it gets /clock every 1/50 s of sim time
 (pub_clock_frequency 50) and at most max(watch_rate 30, 50) = 50 ticks per wall second. Then
 it subscribes to /odom, as a controller would, and gets every tick the simulator sends: more
