@@ -206,3 +206,12 @@ def test_a_watchers_calls_are_not_waited_for():
     board.take("/recorder", 1, 1, taken={}, written={}, watcher=True)
     assert not board.pending_calls({"/recorder"})
     assert board.busy({"/recorder"}) is None
+
+
+def test_what_a_controller_sends_a_watcher_is_not_waited_for():
+    # a watcher reports no more once it has said so (rospy_hooks.watch_only): its counts of
+    # what a controller sent it (the bench's own /cmd_vel counter) never catch up
+    board, _ = make()
+    board.take("/bench", 1, 1, taken={}, written={}, watcher=True)
+    board.take("/ctl", 2, 1, taken={}, written={("/cmd_vel", "/bench", 8): 5})
+    assert board.busy({"/ctl", "/bench"}) is None

@@ -219,7 +219,8 @@ class Board:
                 if (topic, node, port) in inbound and \
                         taken_own.get((topic, node, port), 0) < count:
                     return node, "%s not read by the simulator yet" % topic
-            elif peer in nodes and peer not in self.silent:
+            elif peer in nodes and peer not in self.silent and not self._watcher(peer):
+                # (a watcher is never waited for, and reports no more once it said so)
                 other = self._reports.get(peer)
                 if other is not None and other.taken.get((topic, node, port), 0) < count:
                     return peer, "%s from %s not taken in" % (topic, node)
