@@ -1,6 +1,7 @@
 """The tools' calls to the simulator's Gazebo services (a rospy node must be initialised):
-pause/unpause/reset (std_srvs/Empty), every model's pose, and placing a model."""
-from ..names import GET_MODEL_STATE_SERVICE, SET_MODEL_STATE_SERVICE, WORLD_PROPERTIES_SERVICE
+pause/unpause/reset (std_srvs/Empty), every model's pose, placing a model and spawning one."""
+from ..names import (GET_MODEL_STATE_SERVICE, SET_MODEL_STATE_SERVICE, SPAWN_SERVICE,
+                     WORLD_PROPERTIES_SERVICE)
 
 
 def call_empty(name, timeout=10.0):
@@ -105,3 +106,21 @@ class Services:
             proxy = self._proxies.pop(key, None)
             if proxy is not None:
                 proxy.close()
+
+
+def spawn_urdf_model(name, urdf_xml, x, y, z, yaw, timeout=10.0):
+    """Spawns model `name` from `urdf_xml` at (x, y, z) [m] heading `yaw` [rad] in the world
+    frame and the root namespace, as `spawn_model -urdf` does by default; RuntimeError with
+    the simulator's answer when it refuses."""
+    import rospy
+    from gazebo_msgs.srv import SpawnModel
+    from geometry_msgs.msg import Pose
+    from pybullet_gazebo.engine.transforms import quaternion_from_rpy
+    rospy.wait_for_service(SPAWN_SERVICE, timeout=timeout)
+    pose = Pose()
+    pose.position.x, pose.position.y, pose.position.z = float(x), float(y), float(z)
+    o = pose.orientation
+    o.x, o.y, o.z, o.w = quaternion_from_rpy(0.0, 0.0, yaw)
+    answer = rospy.ServiceProxy(SPAWN_SERVICE, SpawnModel)(name, urdf_xml, "/", pose, "")
+    if not answer.success:
+        raise RuntimeError("%s refused %s: %s" % (SPAWN_SERVICE, name, answer.status_message))

@@ -8,7 +8,6 @@ ROS_LOG_DIR=<log_dir>/ros; the caller's own ROS_MASTER_URI is never used, so a m
 user runs is left alone. `stop()` ends the children (SIGINT, then SIGTERM, SIGKILL) and
 checks that no process of the session is left (`processes.leftovers`).
 """
-import math
 import os
 import re
 import sys
@@ -162,27 +161,18 @@ class Session:
         for model m2wr at (x, y, z, yaw), as spawn_model makes it. For tools that spawn once a
         run: spawn.launch starts three Python interpreters (roslaunch, xacro, spawn_model),
         about 2 s. The URDF is made once a session. SessionError with the simulator's answer
-        when the spawn is refused."""
+        when the spawn is refused (gazebo.spawn_urdf_model)."""
         import rospy
-        from gazebo_msgs.srv import SpawnModel
-        from geometry_msgs.msg import Pose
         from ..paths import robot_urdf
+        from .gazebo import spawn_urdf_model
         if self._urdf is None:
             self._urdf = robot_urdf()
         rospy.set_param(ROBOT_DESCRIPTION_PARAM, self._urdf)
-        pose = Pose()
-        pose.position.x, pose.position.y, pose.position.z = float(x), float(y), float(z)
-        pose.orientation.z, pose.orientation.w = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
         try:
-            rospy.wait_for_service(SPAWN_SERVICE, timeout=timeout)
-            answer = rospy.ServiceProxy(SPAWN_SERVICE, SpawnModel)(
-                "m2wr", self._urdf, "/", pose, "")
-        except (rospy.ROSException, rospy.ServiceException) as error:
-            raise SessionError("spawning m2wr at (%g, %g, yaw %g): %s on %s"
-                               % (x, y, yaw, error, SPAWN_SERVICE)) from None
-        if not answer.success:
-            raise SessionError("spawning m2wr at (%g, %g, yaw %g) was refused: %s"
-                               % (x, y, yaw, answer.status_message))
+            spawn_urdf_model("m2wr", self._urdf, x, y, z, yaw, timeout)
+        except (rospy.ROSException, rospy.ServiceException, RuntimeError) as error:
+            raise SessionError("spawning m2wr at (%g, %g, yaw %g) failed: %s"
+                               % (x, y, yaw, error)) from None
 
     def start_spawn(self, x, y, yaw):
         self._spawn_pose = (float(x), float(y), float(yaw))
