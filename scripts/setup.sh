@@ -151,5 +151,19 @@ seconds="$("$VENV/bin/python" -c \
   || fail "numba could not compile pybullet_gazebo/engine/ray_kernel.py (error above)"
 say "4/4 ray caster compiled or loaded from numba's cache in $seconds s"
 
+STEP="byte-compile"
+# Every node, tool and test is a new Python process that imports the simulator and the tools.
+# Where PYTHONDONTWRITEBYTECODE is set (as on some CI machines), Python never keeps what it
+# compiles, and each of those processes would compile ~20,000 lines again at start; so they
+# are compiled once here (compileall writes whatever that variable says; a source edited
+# later is simply compiled again in memory until the next set-up).
+libraries=("$ROOT/scripts/m2wr_tools" "$ROOT"/simulation_ws/src/*/src "$ROOT"/catkin_ws/src/*/src
+           "$ROOT"/simulation_ws/devel/lib/python3/dist-packages "$ROOT"/catkin_ws/devel/lib/python3/dist-packages)
+existing=()
+for dir in "${libraries[@]}"; do [ -d "$dir" ] && existing+=("$dir"); done
+"$VENV/bin/python" -m compileall -q -j 0 "${existing[@]}" > /dev/null \
+  || fail "byte-compiling the project's Python packages failed (a syntax error? run: $VENV/bin/python -m compileall ${existing[*]})"
+say "4/4 Python packages byte-compiled (${#existing[@]} folders)"
+
 STEP="done"
 say "ready: run 'source scripts/env.sh' to use roscore, roslaunch and rosrun"
