@@ -1,4 +1,6 @@
-"""Loads lockstep's rospy hooks (rospy_hooks.py) into a Python process as rospy is imported.
+"""Loads lockstep's rospy hooks (rospy_hooks.py) into a Python process as rospy is imported,
+and quick_exit's (rospy's shutdown without its half-second wait: runs start and stop many
+controllers).
 
 scripts/setup.sh puts a .pth file into the project's venv that imports this module at every
 interpreter start (`source scripts/env.sh`, roslaunch, rosrun, the batch runner, the grader's
@@ -32,6 +34,8 @@ class _AfterRospy:
                 rospy_hooks.install()
             except ImportError:         # a workspace without lockstep_msgs built: no hooks
                 pass
+            from pybullet_gazebo.ros import quick_exit
+            quick_exit.install()
         spec.loader.exec_module = exec_module
         return spec
 

@@ -1,0 +1,54 @@
+"""quick_exit: rospy's registration thread sees the shutdown flag as soon as it is raised.
+
+rospy wakes that thread before it raises the flag, so the thread waits once more (0.5 s) and
+signal_shutdown joins it. Here the thread's condition waits without end unless woken, so
+rospy alone would leave it waiting and the fix is told apart by outcome, not by timing. Each
+case runs in its own interpreter: rospy's shutdown is for the whole process. No ROS master:
+the thread is rospy's own RegManager loop, started as init_node starts it.
+"""
+import subprocess
+import sys
+
+import pytest
+
+CASE = r"""
+import threading
+import time
+import rospy.core
+from rospy.impl.registration import RegManager
+from pybullet_gazebo.ros import quick_exit
+
+
+class WaitsUntilWoken(threading.Condition):
+    def wait(self, timeout=None):
+        return super().wait(None)
+
+
+class Handler:
+    done = False
+
+
+manager = RegManager(Handler())             # adds its wake-up as a pre-shutdown hook
+manager.cond = WaitsUntilWoken()
+thread = threading.Thread(target=manager.run, daemon=True)
+thread.start()
+while not manager.cond._waiters:            # until the thread waits on its condition
+    time.sleep(0.001)
+# in a node, the wake-up is followed by the unregistration calls to the master: the thread
+# looks again before the flag is raised
+rospy.core.add_preshutdown_hook(lambda _reason: time.sleep(0.2))
+if WAKE:
+    quick_exit.wake_registration_thread_at_shutdown()
+rospy.core._TIMEOUT_SHUTDOWN_JOIN = 2.0     # how long signal_shutdown joins the thread
+rospy.core._add_shutdown_thread(thread)
+rospy.core.signal_shutdown("test")
+print("thread alive after shutdown:", thread.is_alive())
+"""
+
+
+@pytest.mark.parametrize("wake, alive", [(True, False), (False, True)])
+def test_the_registration_thread_ends_with_the_shutdown_only_when_woken_after_the_flag(wake, alive):
+    done = subprocess.run([sys.executable, "-c", "WAKE = %r\n" % wake + CASE],
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=60)
+    assert done.returncode == 0, done.stdout
+    assert "thread alive after shutdown: %s" % alive in done.stdout, done.stdout
