@@ -207,21 +207,27 @@ class Session:
 
     def start_episode(self, world, start, lockstep=True, real_time_factor=0.0, seed=0,
                       pub_clock_frequency=None, gui=False, controller=TUTORIAL_CONTROLLER,
-                      say=lambda _text: None, extra=()):
+                      say=lambda _text: None, extra=(), in_process_spawn=False):
         """The simulator paused on `world`, m2wr spawned at `start` (x [m], y [m], yaw [rad])
         and `controller` connected to its scan and cmd_vel: ready to unpause. The spawn
         starts at once (it waits for the simulator's service), the controller once the
         simulator is up, so that /use_sim_time is set when it starts. `extra`: more
-        `name:=value` arguments of the world's launch file."""
+        `name:=value` arguments of the world's launch file. `in_process_spawn`: spawn from
+        this process (spawn_in_process; its rospy node must be initialised on this session's
+        master) instead of spawn.launch, for tools and tests that start many episodes."""
         self.launch_world(world, gui=gui, real_time_factor=real_time_factor, lockstep=lockstep,
                           seed=seed, paused=True, pub_clock_frequency=pub_clock_frequency,
                           extra=extra)
         say("spawning m2wr at x %g y %g yaw %g" % tuple(start))
-        self.start_spawn(*start)
+        if not in_process_spawn:
+            self.start_spawn(*start)
         self.wait_for_simulator()
+        if in_process_spawn:
+            self.spawn_in_process(*start)
         say("starting %s" % os.path.basename(controller[-1]))
         self.start_controller(controller)
-        self.finish_spawn()
+        if not in_process_spawn:
+            self.finish_spawn()
         self.wait_for_controller(label=os.path.basename(controller[-1]))
 
     def start_bag(self, path, topics):
@@ -307,6 +313,8 @@ class Session:
         try:
             import rospy
             if rospy.core.is_initialized():
+                from pybullet_gazebo.ros.quick_exit import wake_registration_thread_at_shutdown
+                wake_registration_thread_at_shutdown()
                 rospy.signal_shutdown("%s finished" % tool)
         except ImportError:
             pass
