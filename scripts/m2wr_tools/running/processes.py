@@ -29,6 +29,11 @@ def port_in_use(port, host="127.0.0.1"):
         return sock.connect_ex((host, port)) == 0
 
 
+def _default_sigint():
+    """In a child between fork and exec: SIGINT as a fresh program gets it."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 class Child:
     """A command started in a new session (its own process group), output to a log file;
     with `user` and `group` (ids; needs root) as that user with no supplementary groups, in
@@ -41,11 +46,16 @@ class Child:
         os.makedirs(os.path.dirname(os.path.abspath(log_path)), exist_ok=True)
         self._log = open(log_path, "wb")
         as_user = {} if user is None else dict(user=user, group=group, extra_groups=[])
+        # A child is stopped with SIGINT (stop()). A program started in the background by a
+        # non-interactive shell (`nohup scripts/test.sh &`, some CI runners) has SIGINT
+        # ignored, and an ignored signal stays ignored across exec: every ROS process started
+        # from it would sit out the SIGINT and be stopped only by stop()'s SIGTERM, 20 s later.
+        restore = _default_sigint if signal.getsignal(signal.SIGINT) == signal.SIG_IGN else None
         try:
             self.popen = subprocess.Popen(self.argv, env=env, stdout=self._log,
                                           stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                           start_new_session=True, pass_fds=tuple(pass_fds),
-                                          cwd=cwd, **as_user)
+                                          cwd=cwd, preexec_fn=restore, **as_user)
         except OSError as err:
             self._log.close()
             raise RuntimeError("cannot start %s (%s): %s" % (name, " ".join(self.argv), err))
