@@ -20,6 +20,8 @@ only in lockstep.
 Connections are named by the TCP port of the subscriber's end (lockstep_msgs/LockstepReport).
 """
 import os
+import select
+import socket
 import threading
 import time
 import weakref
@@ -403,8 +405,38 @@ def _open_publisher():
 
 
 def _reporting():
+    """Whether a simulator listens: a live connection on the report publisher. rospy keeps a
+    connection whose subscriber has gone until a write to it fails, and the first write after
+    the peer closed does not fail: that report, and the service calls it names (news once),
+    would be lost. A process that outlives one simulator and calls the next one's service
+    (a tool's node spawning the robot, run after run) then held that simulator for a
+    lockstep_timeout, waiting for word of the call. So connections whose peer has closed
+    are dropped first, and the report waits for the next simulator's connection."""
     publisher = _publisher
-    return publisher is not None and publisher.get_num_connections() > 0
+    if publisher is None:
+        return False
+    impl = publisher.impl
+    for connection in list(impl.connections):
+        if _peer_closed(connection):
+            impl.remove_connection(connection)
+            connection.close()
+    return publisher.get_num_connections() > 0
+
+
+def _peer_closed(connection):
+    """True when the subscriber's end of a publisher connection has closed. A subscriber
+    sends nothing after the connection header, so a readable socket is one at its end."""
+    sock = getattr(connection, "socket", None)
+    if sock is None:
+        return False
+    try:
+        if not select.select([sock], [], [], 0)[0]:
+            return False
+        return sock.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
+    except BlockingIOError:
+        return False
+    except (OSError, ValueError):           # reset by the peer, or closed here already
+        return True
 
 
 def _message(report):
