@@ -95,9 +95,10 @@ def frames(scene, track, robot_links, period=FRAME_PERIOD, hits=REPLAY_HITS):
                  "hits": {}}
         points, origin = [], None
         for sensor in lasers:
-            sensor_origin, flat = laser_hits(sensor, sensor.measure(t), limit=hits)
+            sensor_origin, flat = laser_hits(sensor, sensor.measure(t), limit=hits,
+                                             decimals=2)
             origin = origin or sensor_origin
-            points.extend(round(v, 2) for v in flat)
+            points.extend(flat)
         if lasers:
             frame["hits"][robot.name] = {"from": origin, "points": points}
         out.append(frame)
