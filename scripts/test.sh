@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Runs every test suite: scripts/setup.sh (if anything is missing), then the rostest suites of
-# both workspaces through catkin in the background, beside the unit tests (pytest, no ROS
-# master) and then the integration tests (pytest: the batch runner, the grader, lockstep, the
+# Runs every test suite: scripts/setup.sh (if anything is missing), then in the background the
+# rostest suites of both workspaces through catkin and, beside them, the comparisons of
+# lockstep with real-time runs; in the foreground the unit tests (pytest, no ROS master) and
+# then the other integration tests (pytest: the batch runner, the grader, lockstep, the
 # browser view). Results and logs go to test_results/.
 # Exits non-zero when any test fails or a rostest crashed without writing its results, and
 # ends with one line `N passed, N failed, N skipped`.
@@ -36,10 +37,10 @@ rm -rf "$RESULTS" && mkdir -p "$RESULTS"
 # lower priority (nice 10), so that the rostests' real-time simulators get the CPU when they
 # need it. (Two computing streams side by side do not pay on 2 cores, and the real-time
 # tests fail under that load.) The integration tests that compare lockstep with real-time runs
-# wait on the wall clock too: they follow the rostests in the background.
+# wait on the wall clock too: a third stream, beside the rostests.
 WALL_BOUND="$ROOT/scripts/test/integration/test_series_lockstep_vs_real_time.py"
 PYTEST=(python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib)
-run_background() {
+run_rostests() {
   for ws in simulation_ws catkin_ws; do
     echo "[rostest] $ws (catkin_make run_tests, one at a time)"
     (
@@ -49,6 +50,8 @@ run_background() {
     ) > "$RESULTS/$ws-run_tests.log"
     cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
   done
+}
+run_wall_bound() {
   echo "[integration, real time] $WALL_BOUND"
   "${PYTEST[@]}" --basetemp="$RESULTS/wall-bound-tmp" --junitxml="$RESULTS/pytest-wall-bound.xml" \
     "$WALL_BOUND" > "$RESULTS/pytest-wall-bound.log" 2>&1
@@ -65,21 +68,28 @@ rostest_lines() {
 }
 
 status=0
-background_pid=
+background_pids=()
 stop_background() {
-  if [ -n "$background_pid" ] && kill -0 "$background_pid" 2>/dev/null; then
-    kill -TERM -- "-$background_pid" 2>/dev/null
-    wait "$background_pid" 2>/dev/null
-  fi
+  for pid in "${background_pids[@]}"; do
+    if kill -0 "$pid" 2>/dev/null; then
+      kill -TERM -- "-$pid" 2>/dev/null
+      wait "$pid" 2>/dev/null
+    fi
+  done
 }
 trap 'stop_background; echo; echo "[test] interrupted: every process it started is stopped"; exit 130' INT TERM
 
+# each in its own process group (setsid), so that an interrupt stops all of it by its PID
+start_background() {
+  local fn="$1"
+  setsid bash -c "$(declare -p ROOT RESULTS WALL_BOUND PYTEST); $(declare -f "$fn"); $fn" \
+    > "$RESULTS/background-$fn.log" 2>&1 < /dev/null &
+  background_pids+=($!)
+}
 if [ "$mode" != "--unit" ]; then
-  echo "[test] rostest suites of both workspaces, then $(basename "$WALL_BOUND"), in the background (started now)"
-  # its own process group (setsid), so that an interrupt stops all of it by its PID
-  setsid bash -c "$(declare -p ROOT RESULTS WALL_BOUND PYTEST); $(declare -f run_background); run_background" \
-    > "$RESULTS/background.log" 2>&1 < /dev/null &
-  background_pid=$!
+  echo "[test] in the background (started now): the rostest suites of both workspaces; beside them $(basename "$WALL_BOUND")"
+  start_background run_rostests
+  start_background run_wall_bound
 fi
 
 echo "[test] unit tests (pytest, no ROS master)"
@@ -94,11 +104,14 @@ if [ "$mode" != "--unit" ]; then
   echo "[test] batch runner, grader, lockstep, browser (pytest: real Dask scheduler and workers, chromium)"
   nice -n 10 "${PYTEST[@]}" --basetemp="$RESULTS/batch-tmp" --junitxml="$RESULTS/pytest-batch.xml" \
     --ignore="$WALL_BOUND" "$ROOT/scripts/test/integration" || status=1
-  if kill -0 "$background_pid" 2>/dev/null; then
-    echo "[test] waiting for the background tests (rostests, real-time comparisons)"
-  fi
-  wait "$background_pid" 2>/dev/null
-  background_pid=
+  for pid in "${background_pids[@]}"; do
+    if kill -0 "$pid" 2>/dev/null; then
+      echo "[test] waiting for the background tests (rostests, real-time comparisons)"
+      break
+    fi
+  done
+  for pid in "${background_pids[@]}"; do wait "$pid" 2>/dev/null; done
+  background_pids=()
   rostest_lines
   echo "[test] $(basename "$WALL_BOUND") (log: test_results/pytest-wall-bound.log)"
   tail -n 3 "$RESULTS/pytest-wall-bound.log" 2>/dev/null | sed 's/^/    /'
