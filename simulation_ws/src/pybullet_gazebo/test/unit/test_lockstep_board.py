@@ -215,3 +215,21 @@ def test_what_a_controller_sends_a_watcher_is_not_waited_for():
     board.take("/bench", 1, 1, taken={}, written={}, watcher=True)
     board.take("/ctl", 2, 1, taken={}, written={("/cmd_vel", "/bench", 8): 5})
     assert board.busy({"/ctl", "/bench"}) is None
+
+
+def test_a_call_reported_before_the_simulator_noted_its_answer_is_not_waited_for_again():
+    """The simulator notes that it answered a call once its handler has returned, after the
+    reply is written: the client may get the answer and report the call before that, and the
+    board may be asked in between. The call is then matched when the note comes, and the
+    client, whose word on it is in, is not waited for (it was, until lockstep_timeout: 30 s
+    in series_runs, whose node spawns m2wr)."""
+    noted = []
+    own = Own()
+    board = Board(SIM, own, service_provider={"/gazebo/spawn_urdf_model": SIM}.get,
+                  own_answered=lambda: [noted.pop()] if noted else [])
+    board.take("/tool", 1, 1, taken={}, written={},
+               called=[("/gazebo/spawn_urdf_model", 7)])
+    assert board.busy({"/tool"}) is None                  # asked before the note
+    noted.append(("/gazebo/spawn_urdf_model", 7, "/tool"))
+    assert board.busy({"/tool"}) is None                  # the note matches the word
+    assert not board.pending_calls({"/tool"})
