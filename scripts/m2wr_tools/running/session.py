@@ -219,11 +219,12 @@ class Session:
                           seed=seed, paused=True, pub_clock_frequency=pub_clock_frequency,
                           extra=extra)
         say("spawning m2wr at x %g y %g yaw %g" % tuple(start))
-        if not in_process_spawn:
-            self.start_spawn(*start)
-        self.wait_for_simulator()
         if in_process_spawn:
+            self.wait_for_simulator()
             self.spawn_in_process(*start)
+        else:
+            self.start_spawn(*start)          # it waits for the simulator's service itself
+            self.wait_for_simulator()
         say("starting %s" % os.path.basename(controller[-1]))
         self.start_controller(controller)
         if not in_process_spawn:
@@ -313,8 +314,6 @@ class Session:
         try:
             import rospy
             if rospy.core.is_initialized():
-                from pybullet_gazebo.ros.quick_exit import wake_registration_thread_at_shutdown
-                wake_registration_thread_at_shutdown()
                 rospy.signal_shutdown("%s finished" % tool)
         except ImportError:
             pass

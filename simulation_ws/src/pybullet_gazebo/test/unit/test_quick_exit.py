@@ -3,9 +3,11 @@
 rospy wakes that thread before it raises the flag, so the thread waits once more (0.5 s) and
 signal_shutdown joins it. Here the thread's condition waits without end unless woken, so
 rospy alone would leave it waiting and the fix is told apart by outcome, not by timing. Each
-case runs in its own interpreter: rospy's shutdown is for the whole process. No ROS master:
+case runs in its own interpreter (rospy's shutdown is for the whole process), without the
+autoload hook (LOCKSTEP_HANDSHAKE=off), which would install quick_exit itself. No ROS master:
 the thread is rospy's own RegManager loop, started as init_node starts it.
 """
+import os
 import subprocess
 import sys
 
@@ -28,6 +30,8 @@ class Handler:
     done = False
 
 
+if WAKE:
+    quick_exit.install()                    # before the node's RegManager is made
 manager = RegManager(Handler())             # adds its wake-up as a pre-shutdown hook
 manager.cond = WaitsUntilWoken()
 thread = threading.Thread(target=manager.run, daemon=True)
@@ -37,8 +41,6 @@ while not manager.cond._waiters:            # until the thread waits on its cond
 # in a node, the wake-up is followed by the unregistration calls to the master: the thread
 # looks again before the flag is raised
 rospy.core.add_preshutdown_hook(lambda _reason: time.sleep(0.2))
-if WAKE:
-    quick_exit.wake_registration_thread_at_shutdown()
 rospy.core._TIMEOUT_SHUTDOWN_JOIN = 2.0     # how long signal_shutdown joins the thread
 rospy.core._add_shutdown_thread(thread)
 rospy.core.signal_shutdown("test")
@@ -48,7 +50,9 @@ print("thread alive after shutdown:", thread.is_alive())
 
 @pytest.mark.parametrize("wake, alive", [(True, False), (False, True)])
 def test_the_registration_thread_ends_with_the_shutdown_only_when_woken_after_the_flag(wake, alive):
-    done = subprocess.run([sys.executable, "-c", "WAKE = %r\n" % wake + CASE],
+    # without the autoload hook, which installs quick_exit in every process of the venv
+    env = dict(os.environ, LOCKSTEP_HANDSHAKE="off")
+    done = subprocess.run([sys.executable, "-c", "WAKE = %r\n" % wake + CASE], env=env,
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=60)
     assert done.returncode == 0, done.stdout
     assert "thread alive after shutdown: %s" % alive in done.stdout, done.stdout

@@ -4,42 +4,28 @@ rospy's shutdown wakes its registration thread (RegManager) before it raises the
 flag, so the thread looks, sees no shutdown yet, and waits 0.5 s more on its condition, which
 signal_shutdown then joins: every rospy node takes up to 0.5 s longer to exit than it needs.
 The simulator and the tools start and stop many nodes (every run of the batch runner, the
-grader and the tests), so their own nodes wake that thread once more after the flag is up.
+grader and the tests), so every node of the project's environment wakes that thread once more
+after the flag is up (lockstep/autoload.py installs this as rospy is imported; the world node
+and the batch runner's warm interpreters install it themselves).
 """
-import functools
-
-import rospy
-import rospy.client
 import rospy.core
 from rospy.impl.registration import RegManager
 
-_woken = set()            # ids of the RegManagers whose condition is woken at shutdown
-
-
-def wake_registration_thread_at_shutdown():
-    """Call after rospy.init_node: at shutdown, once the flag is raised, the node's
-    registration thread is woken to see it. Does nothing before init_node, nor twice."""
-    for hook in list(rospy.core._preshutdown_hooks):
-        manager = getattr(hook, "__self__", None)
-        if isinstance(manager, RegManager) and id(manager) not in _woken:
-            _woken.add(id(manager))
-            rospy.core.add_shutdown_hook(lambda _reason, cond=manager.cond: _notify_all(cond))
-            return
-
 
 def install():
-    """Every later rospy.init_node of this process does the above (lockstep/autoload.py
-    calls this as rospy is imported, so a controller's exit is quick too)."""
-    init_node = rospy.client.init_node
+    """Every RegManager made from now on (rospy.init_node makes the node's one) is woken by
+    a shutdown hook, which runs once the flag is up. Call before rospy.init_node; a second
+    call changes nothing."""
+    if getattr(RegManager, "_wakes_at_shutdown", False):
+        return
+    original_init = RegManager.__init__
 
-    @functools.wraps(init_node)
-    def init_node_then_wake_at_shutdown(*args, **kwds):
-        result = init_node(*args, **kwds)
-        wake_registration_thread_at_shutdown()
-        return result
-    rospy.init_node = rospy.client.init_node = init_node_then_wake_at_shutdown
+    def init(self, handler):
+        original_init(self, handler)
 
-
-def _notify_all(cond):
-    with cond:
-        cond.notify_all()
+        def wake(_reason):
+            with self.cond:          # (read at shutdown: the condition the thread waits on)
+                self.cond.notify_all()
+        rospy.core.add_shutdown_hook(wake)
+    RegManager.__init__ = init
+    RegManager._wakes_at_shutdown = True
