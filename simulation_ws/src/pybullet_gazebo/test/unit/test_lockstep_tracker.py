@@ -338,3 +338,58 @@ def test_a_sleep_begun_before_the_first_clock_counts_from_that_tick_as_the_track
     finally:
         (rospy.rostime._rostime_current, rospy.rostime._rostime_initialized,
          rospy_hooks.TRACKER) = saved
+
+
+def test_a_thread_that_ends_while_due_is_not_waited_for():
+    """A poller held, then made due by a callback, whose loop ends instead of looking again
+    (rospy's reconnect thread of a simulator that has gone): it does nothing more. Kept due,
+    the process was never done again, and the next simulator waited a lockstep_timeout
+    for every report of a tool's node that outlived the last one (series_runs, third run)."""
+    tracker, reports = make()
+    alive = {7}
+    tracker.thread_alive = lambda tid: tid in alive
+    tracker.polled(7)
+    tracker.callback_started()
+    tracker.callback_ended(*SCAN, count=1)
+    tracker.sleep_started(tid=7, start=MS, duration=MS)
+    tracker.time_set(2 * MS)
+    tracker.sleep_ended(7)                     # due: at work until it sleeps or polls
+    assert not tracker.done()
+    alive.clear()                              # it ended instead
+    assert tracker.done()
+    tracker.call_started(tid=8)
+    tracker.call_answered("/gazebo/spawn_urdf_model", 41000)
+    tracker.call_ended(tid=8)
+    assert reports[-1]["called"] == [("/gazebo/spawn_urdf_model", 41000)]
+
+
+def test_rospys_own_reconnect_loop_is_not_taken_for_a_busy_loop():
+    """rospy's subscriber (re)connect loops call rospy.is_shutdown() between a connection
+    attempt and a wall-clock sleep: not the program's loop. The program's own calls are."""
+    import rospy
+    from rospy.impl import tcpros_pubsub
+    from pybullet_gazebo.ros.lockstep import rospy_hooks
+    tracker = rospy_hooks.TRACKER or rospy_hooks.install(report=False)
+    counting_only, tracker.counting_only = tracker.counting_only, False
+    tid = threading.get_ident()
+
+    class Connection:                          # connects at the second attempt
+        socket, done, attempts = None, False, 0
+
+        def connect(self, *args, **kwds):
+            self.attempts += 1
+            if self.attempts == 2:
+                self.socket = object()
+
+        def receive_loop(self, callback):
+            pass
+    tracker.forget_thread(tid)
+    try:
+        tcpros_pubsub.robust_connect_subscriber(Connection(), "localhost", 1, "http://x:1/",
+                                                None, "/odom")
+        assert tracker._last.get(tid) is None       # rospy's two polls: not counted
+        rospy.is_shutdown()
+        assert tracker._last.get(tid) == "poll"     # the program's: counted
+    finally:
+        tracker.counting_only = counting_only
+        tracker.forget_thread(tid)

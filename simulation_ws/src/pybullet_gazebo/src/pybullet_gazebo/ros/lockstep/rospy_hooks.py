@@ -7,7 +7,7 @@ install() wraps, in the rospy module of this process:
                                      connection's socket: its queue empties)
   QueuedConnection.write_data        messages entering a queued connection's queue
   rospy.sleep, rospy.timer.sleep     a thread sleeping until a sim time (rospy.Rate, Timer)
-  rospy.is_shutdown                  a thread polling
+  rospy.is_shutdown                  a thread polling (the program's: not rospy's own)
   time.sleep                         a thread waiting for the wall clock: not waited for
   threading.Condition.wait, notify   a thread handed work by another (queue.Queue, Event)
   ServiceProxy.call                  a service call in flight; its answer read
@@ -22,6 +22,7 @@ Connections are named by the TCP port of the subscriber's end (lockstep_msgs/Loc
 import os
 import select
 import socket
+import sys
 import threading
 import time
 import weakref
@@ -64,6 +65,9 @@ def install(report=True):
     def pending_writes():
         return any(not q._connection.done for q in list(waiting))
     tracker.pending_writes = pending_writes
+    # (threading's table of the threads it started and has not seen end: rospy starts all
+    # of a program's threads through threading)
+    tracker.thread_alive = lambda tid: tid in threading._active
 
     def after_fork():
         """A warm interpreter's child (m2wr_tools.running.zygote): nothing of its parent's threads,
@@ -212,7 +216,11 @@ def install(report=True):
     is_shutdown = rospy.core.is_shutdown
 
     def polled_is_shutdown():
-        tracker.polled(get_ident())
+        # rospy's own connect and reconnect loops ask too (between a connection attempt
+        # and a wall-clock sleep): they are not the program's loop waiting for a change,
+        # and a thread of theirs held here would come back to connect 50 ms late
+        if not sys._getframe(1).f_globals.get("__name__", "").startswith("rospy."):
+            tracker.polled(get_ident())
         return is_shutdown()
     rospy.is_shutdown = polled_is_shutdown
 

@@ -40,6 +40,7 @@ class Tracker:
         self.send = send                  # send(report dict): to the simulator
         self.reporting = reporting        # () -> True while the simulator listens
         self.pending_writes = lambda: 0   # messages waiting in queued connections
+        self.thread_alive = lambda tid: True   # whether thread `tid` still runs
         self.on_change = None             # called (no lock held) when `taken` grows
         self.counting_only = False
         self.start_over()
@@ -287,7 +288,18 @@ class Tracker:
             return self._done()
 
     def _done(self):
+        if self._due:
+            self._forget_ended()
         return not (self._running or self._calls or self._due or self.pending_writes())
+
+    def _forget_ended(self):
+        """A thread due when it ended (a loop that stopped after a look, rospy's reconnect
+        thread of a publisher that went away) does nothing more: were it kept, the process
+        would never be done again, and every report after it would wait for lockstep_timeout."""
+        for tid in [tid for tid in self._due if not self.thread_alive(tid)]:
+            self._due.discard(tid)
+            self._sleeping.pop(tid, None)
+            self._last.pop(tid, None)
 
     def _wake_sleepers(self, now):
         """Marks due the sleepers whose time has come; True if there were any, or if a
