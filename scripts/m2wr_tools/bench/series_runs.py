@@ -129,14 +129,25 @@ def sim_time_now():
     return rospy.ServiceProxy(WORLD_PROPERTIES_SERVICE, GetWorldProperties)().sim_time
 
 
-def wait_until(condition, timeout, what, check=lambda: None):
+def wait_until(condition, timeout, what, check=lambda: None, evidence=lambda: ""):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         if condition():
             return
         check()
         time.sleep(0.02)
-    raise SessionError("%s within %.0f s" % (what, timeout))
+    raise SessionError("%s within %.0f s%s" % (what, timeout, evidence()))
+
+
+def connection_evidence(session, nodes):
+    """What the nodes are connected to, and the end of the controller's log: for an error
+    message that says why a connection was not made."""
+    lines = [session.describe_connections(node) for node in nodes]
+    controller = session.child("controller")
+    if controller is not None:
+        lines.append("the controller's log (%s) ends:\n%s" % (controller.log_path,
+                                                               controller.log_tail(15)))
+    return "\n" + "\n".join(lines)
 
 
 def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
@@ -171,7 +182,8 @@ def run_once(session, watcher, run: SeriesRun, wall_limit=600.0):
         for node, topic in connections:
             wait_until(lambda: session.connected(node, topic, "/gazebo"), 60.0,
                        "%s did not connect to the simulator on %s" % (node, topic),
-                       lambda: session.check_running(["world", "controller"]))
+                       lambda: session.check_running(["world", "controller"]),
+                       lambda: connection_evidence(session, [node, "/gazebo"]))
         if start_call is not None:
             node, service = start_call
             wait_until(lambda: gazebo_calls.called(gazebo_calls.read(call_log)[0], service,

@@ -255,6 +255,24 @@ class Session:
                 return True
         return False
 
+    def describe_connections(self, node):
+        """`node`'s address on the master and its live connections, as a line for an error
+        message (what a "did not connect" needs to be understood afterwards)."""
+        uri = self.node_uri(node)
+        if uri is None:
+            return "%s: not registered on the master" % node
+        try:
+            with xmlrpc.client.ServerProxy(uri) as proxy:
+                code, _, bus = proxy.getBusInfo("/" + self.name)
+        except (OSError, xmlrpc.client.Error) as error:
+            return "%s at %s: does not answer (%s)" % (node, uri, error)
+        if code != 1:
+            return "%s at %s: no bus information" % (node, uri)
+        # [id, destination, direction, transport, topic, connected, ...]
+        return "%s at %s: %s" % (node, uri, ", ".join(sorted(
+            "%s %s %s%s" % (c[4], c[2], c[1], "" if c[5] else " (not connected)")
+            for c in bus if len(c) >= 6)) or "no connections")
+
     def wait_for_controller(self, timeout=30.0, node=CONTROLLER_NODE,
                             label="obstacle_avoidance.py"):
         """Until the simulator sends scans to the controller's `node` and hears its cmd_vel."""

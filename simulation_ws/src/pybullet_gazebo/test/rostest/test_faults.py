@@ -12,10 +12,13 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import unittest
+import xmlrpc.client
 
+import rosgraph
 import rospkg
 import rospy
 import rostest
@@ -54,11 +57,13 @@ class CommandWatch:
     def __init__(self):
         self._lock = threading.Lock()
         self.received = []                 # (wall time [s], caller id)
+        self.last = None                   # (linear.x, angular.z) of the latest
         self._sub = rospy.Subscriber("/cmd_vel", Twist, self._on_command, queue_size=100)
 
     def _on_command(self, msg):
         with self._lock:
             self.received.append((time.monotonic(), msg._connection_header["callerid"]))
+            self.last = (msg.linear.x, msg.angular.z)
 
     def count_after(self, wall_time):
         with self._lock:
@@ -69,8 +74,21 @@ class CommandWatch:
                    "a /cmd_vel from the controller (is it running?)", interval=0.05)
 
 
+def simulator_connections(topic="/cmd_vel"):
+    """The simulator's connections on `topic`, from its own bus information."""
+    try:
+        master = rosgraph.Master("/test_faults")
+        uri = master.lookupNode("/gazebo")
+        code, _, bus = xmlrpc.client.ServerProxy(uri).getBusInfo("/test_faults")
+        return [c[1:6] for c in bus if len(c) >= 6 and c[4] == topic] if code == 1 else bus
+    except Exception as error:          # noqa: BLE001 (evidence for a failure message)
+        return "not available (%s)" % error
+
+
 class FaultsTest(unittest.TestCase):
     controller = None
+    controller_log = os.path.join(tempfile.gettempdir(), "test_faults_controller_%d.log"
+                                  % os.getpid())
 
     @classmethod
     def setUpClass(cls):
@@ -87,12 +105,15 @@ class FaultsTest(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         cls.kill_controller()
+        if os.path.exists(cls.controller_log):
+            os.remove(cls.controller_log)
 
     @classmethod
     def start_controller(cls):
         started = time.monotonic()
-        cls.controller = subprocess.Popen(cls.controller_command, stdout=subprocess.DEVNULL,
-                                          stderr=subprocess.DEVNULL, start_new_session=True)
+        with open(cls.controller_log, "ab") as log:
+            cls.controller = subprocess.Popen(cls.controller_command, stdout=log,
+                                              stderr=subprocess.STDOUT, start_new_session=True)
         return started
 
     @classmethod
@@ -103,9 +124,25 @@ class FaultsTest(unittest.TestCase):
 
     def assert_drives_forward(self, seconds=1.5, at_least=0.3):
         """The robot's x grows by at_least [m] within `seconds` [s] of sim time."""
-        t0, x0 = state()[:2]
-        wait_until_sim_time(t0 + seconds)
-        self.assertGreater(state()[1] - x0, at_least)
+        before = state()
+        wait_until_sim_time(before[0] + seconds)
+        after = state()
+        self.assertGreater(after[1] - before[1], at_least, self.evidence(before, after))
+
+    def evidence(self, before, after):
+        """What a failure to drive needs to be understood from CI's log alone."""
+        alive = self.controller is not None and self.controller.poll() is None
+        try:
+            with open(self.controller_log, "rb") as log:
+                tail = [line[:160] for line in
+                        log.read().decode("utf-8", "replace").splitlines()[-4:]]
+        except OSError:
+            tail = []
+        return ("(t, x, y, z, yaw) %s -> %s; %d /cmd_vel heard, the latest %s; the "
+                "simulator's /cmd_vel connections %s; controller %s; its output ends: %s"
+                % (before, after, len(self.commands.received), self.commands.last,
+                   simulator_connections(), "running" if alive else "ended",
+                   " | ".join(tail) or "(none)"))
 
     def test_1_controller_killed_and_restarted(self):
         started = self.start_controller()
@@ -136,7 +173,7 @@ class FaultsTest(unittest.TestCase):
         wait_until_sim_time(rospy.get_time() + 1.0)
         before = state()
         self.assertGreater(before[0], 2.0)
-        self.assertGreater(before[1], 0.3)                    # it has driven away
+        self.assertGreater(before[1], 0.3, self.evidence(before, before))   # it drove away
 
         self.reset_simulation()
         t, x, y, z, yaw = state()
