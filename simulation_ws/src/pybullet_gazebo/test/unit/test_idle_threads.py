@@ -11,7 +11,7 @@ import time
 
 import pytest
 
-from pybullet_gazebo.ros.idle_threads import IdleWatch
+from pybullet_gazebo.ros.lockstep.idle_threads import IdleWatch
 
 # Reads a line from stdin, burns `work` s of CPU, answers "done <line>" on stdout.
 WORKER = """
@@ -201,7 +201,7 @@ def test_work_handed_on_between_threads_and_processes_is_waited_for_to_the_end()
 
 @pytest.mark.parametrize("columns, backlog", [(15, (13, 14)), (13, (11,)), (11, ())])
 def test_the_kernel_backlog_columns_follow_the_kernel(columns, backlog):
-    from pybullet_gazebo.ros.idle_threads import _backlog_columns
+    from pybullet_gazebo.ros.lockstep.idle_threads import _backlog_columns
     assert _backlog_columns(columns) == backlog
 
 

@@ -1,6 +1,6 @@
 """Which processes lockstep watches: the loop nodes found through the master, and the master
 itself (their service calls and parameter reads go through it)."""
-from pybullet_gazebo.ros.node_processes import MASTER, NodeProcesses
+from pybullet_gazebo.ros.lockstep.node_processes import MASTER, NodeProcesses
 
 
 def finder(uris, pids):

@@ -3,7 +3,8 @@ how long."""
 import threading
 import time
 
-from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
+from pybullet_gazebo.ros.lockstep.gate import Lockstep
+from pybullet_gazebo.ros.pacing import RealTimePacer
 
 
 class FakeWatch:

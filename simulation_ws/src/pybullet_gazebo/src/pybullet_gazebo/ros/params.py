@@ -13,7 +13,7 @@ parameters (~name), with units:
                       their own rate) times per wall second; 0 = no limit (watch_rate.py)
   seed                seed of the sensors' noise
   lockstep            before the simulation goes on, wait until the controllers are done
-                      with what they were sent (pacing.py, README "Lockstep")
+                      with what they were sent (lockstep/gate.py, README "Lockstep")
   lockstep_timeout    [s] of wall time: the longest such wait; a controller still at work
                       then is stepped past and named in the run summary
   cmd_vel_timeout     [s] of sim time after which a robot stops without commands; 0 = never

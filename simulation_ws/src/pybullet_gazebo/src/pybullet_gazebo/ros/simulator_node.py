@@ -24,7 +24,7 @@ Topics in: per robot, the diff drive's commandTopic (geometry_msgs/Twist); Gazeb
 ~set_model_state and ~set_link_state (state_services.py). Not /clock: the node is its
 source (see nodes/gazebo_world).
 Parameters: see params.py. All messages of one step carry that step's sim time; wall-clock
-pacing (real_time_factor, lockstep: pacing.py) lives in the adapter, never in the engine.
+pacing (real_time_factor: pacing.py; lockstep: lockstep/gate.py) lives in the adapter, never in the engine.
 """
 import threading
 import time
@@ -44,13 +44,14 @@ from pybullet_gazebo.ros.bindings import BindingContext, DriveBinding, RobotBind
 from pybullet_gazebo.ros.clock_topic import ClockTopic
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
-from pybullet_gazebo.ros.idle_threads import IdleWatch
 from pybullet_gazebo.ros.lockstep import REPORT_TOPIC, rospy_hooks
+from pybullet_gazebo.ros.lockstep.gate import Lockstep
+from pybullet_gazebo.ros.lockstep.idle_threads import IdleWatch
+from pybullet_gazebo.ros.lockstep.node_processes import MASTER, NodeProcesses
+from pybullet_gazebo.ros.lockstep.own_receivers import OwnReceivers
 from pybullet_gazebo.ros.lockstep.board import Board
 from pybullet_gazebo.ros.lockstep.service_providers import ServiceProviders
-from pybullet_gazebo.ros.node_processes import MASTER, NodeProcesses
-from pybullet_gazebo.ros.own_receivers import OwnReceivers
-from pybullet_gazebo.ros.pacing import Lockstep, RealTimePacer
+from pybullet_gazebo.ros.pacing import RealTimePacer
 from pybullet_gazebo.ros.state_topics import StateTopics
 from pybullet_gazebo.ros.watch_rate import topic_limit
 from pybullet_gazebo.ros.web_adapter import open_web_view

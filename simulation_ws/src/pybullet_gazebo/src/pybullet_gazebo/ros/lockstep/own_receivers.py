@@ -22,7 +22,7 @@ from rospy.impl.tcpros_base import TCPServer
 from rospy.impl.tcpros_pubsub import robust_connect_subscriber
 from rospy.impl.tcpros_service import ServiceImpl
 
-from pybullet_gazebo.ros.idle_threads import SOCKET_WAITS, in_socket_wait, state_of
+from pybullet_gazebo.ros.lockstep.idle_threads import SOCKET_WAITS, in_socket_wait, state_of
 
 def _is_reader(thread):
     target = getattr(thread, "_target", None)

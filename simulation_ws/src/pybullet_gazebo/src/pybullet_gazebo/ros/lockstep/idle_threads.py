@@ -1,5 +1,5 @@
 """Whether processes have finished with what they were sent, as Linux shows it: lockstep's
-fallback for the controllers that cannot say so themselves (pacing.py; a process of the
+fallback for the controllers that cannot say so themselves (gate.py; a process of the
 project's environment reports instead, lockstep/).
 
 A controller that sends no reports (roscpp, a Python outside the project's venv) is watched
