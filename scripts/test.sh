@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test suite: scripts/setup.sh (if anything is missing), then in the background the
 # rostest suites of both workspaces through catkin and, beside them, the comparisons of
-# lockstep with real-time runs; in the foreground the unit tests (pytest, no ROS master) and
+# lockstep with real-time runs followed by the batch runner's failure and cluster cases; in
+# the foreground the unit tests (pytest, no ROS master) and
 # then the other integration tests (pytest: the batch runner, the grader, lockstep, the
 # browser view). Results and logs go to test_results/.
 # Exits non-zero when any test fails or a rostest crashed without writing its results, and
@@ -37,8 +38,12 @@ rm -rf "$RESULTS" && mkdir -p "$RESULTS"
 # lower priority (nice 10), so that the rostests' real-time simulators get the CPU when they
 # need it. (Two computing streams side by side do not pay on 2 cores, and the real-time
 # tests fail under that load.) The integration tests that compare lockstep with real-time runs
-# wait on the wall clock too: a third stream, beside the rostests.
+# wait on the wall clock too: a third stream, beside the rostests. It is done long before the
+# other two, so the batch runner's failure and cluster cases follow it there (niced as the
+# foreground, so the real-time simulators still come first).
 WALL_BOUND="$ROOT/scripts/test/integration/test_series_lockstep_vs_real_time.py"
+BESIDE=(test_evaluate_failures.py test_evaluate_worker_lost.py test_evaluate_cluster.py)
+BESIDE=("${BESIDE[@]/#/$ROOT/scripts/test/integration/}")
 PYTEST=(python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib)
 run_rostests() {
   for ws in simulation_ws catkin_ws; do
@@ -55,7 +60,11 @@ run_wall_bound() {
   echo "[integration, real time] $WALL_BOUND"
   "${PYTEST[@]}" --basetemp="$RESULTS/wall-bound-tmp" --junitxml="$RESULTS/pytest-wall-bound.xml" \
     "$WALL_BOUND" > "$RESULTS/pytest-wall-bound.log" 2>&1
-  echo $? > "$RESULTS/pytest-wall-bound.status"
+  local status=$?
+  echo "[integration, beside] ${BESIDE[*]##*/}"
+  nice -n 10 "${PYTEST[@]}" --basetemp="$RESULTS/beside-tmp" --junitxml="$RESULTS/pytest-beside.xml" \
+    "${BESIDE[@]}" > "$RESULTS/pytest-beside.log" 2>&1 || status=1
+  echo $status > "$RESULTS/pytest-wall-bound.status"
 }
 # one progress line per suite; the full output stays in the logs
 rostest_lines() {
@@ -82,7 +91,7 @@ trap 'stop_background; echo; echo "[test] interrupted: every process it started 
 # each in its own process group (setsid), so that an interrupt stops all of it by its PID
 start_background() {
   local fn="$1"
-  setsid bash -c "$(declare -p ROOT RESULTS WALL_BOUND PYTEST); $(declare -f "$fn"); $fn" \
+  setsid bash -c "$(declare -p ROOT RESULTS WALL_BOUND BESIDE PYTEST); $(declare -f "$fn"); $fn" \
     > "$RESULTS/background-$fn.log" 2>&1 < /dev/null &
   background_pids+=($!)
 }
@@ -103,7 +112,7 @@ nice -n 10 "${PYTEST[@]}" --junitxml="$RESULTS/pytest-unit.xml" \
 if [ "$mode" != "--unit" ]; then
   echo "[test] batch runner, grader, lockstep, browser (pytest: real Dask scheduler and workers, chromium)"
   nice -n 10 "${PYTEST[@]}" --basetemp="$RESULTS/batch-tmp" --junitxml="$RESULTS/pytest-batch.xml" \
-    --ignore="$WALL_BOUND" "$ROOT/scripts/test/integration" || status=1
+    --ignore="$WALL_BOUND" "${BESIDE[@]/#/--ignore=}" "$ROOT/scripts/test/integration" || status=1
   for pid in "${background_pids[@]}"; do
     if kill -0 "$pid" 2>/dev/null; then
       echo "[test] waiting for the background tests (rostests, real-time comparisons)"
@@ -115,6 +124,8 @@ if [ "$mode" != "--unit" ]; then
   rostest_lines
   echo "[test] $(basename "$WALL_BOUND") (log: test_results/pytest-wall-bound.log)"
   tail -n 3 "$RESULTS/pytest-wall-bound.log" 2>/dev/null | sed 's/^/    /'
+  echo "[test] ${BESIDE[*]##*/} (log: test_results/pytest-beside.log)"
+  tail -n 3 "$RESULTS/pytest-beside.log" 2>/dev/null | sed 's/^/    /'
   [ "$(cat "$RESULTS/pytest-wall-bound.status" 2>/dev/null)" = 0 ] || status=1
 fi
 
