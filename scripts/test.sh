@@ -45,7 +45,12 @@ WALL_BOUND="$ROOT/scripts/test/integration/test_series_lockstep_vs_real_time.py"
 BESIDE=(test_evaluate_failures.py test_evaluate_worker_lost.py test_evaluate_cluster.py)
 BESIDE=("${BESIDE[@]/#/$ROOT/scripts/test/integration/}")
 PYTEST=(python -m pytest -q -W error -p no:cacheprovider --import-mode=importlib)
+# Each stream's ROS graphs on a loopback address of their own (m2wr_tools.running.session's
+# loopback_host): a master calls the address of a node that was killed without unregistering
+# when that node's topics change, and on one address the port may by then be another
+# stream's node, which would connect to the wrong graph's publishers.
 run_rostests() {
+  export ROS_HOSTNAME=127.0.0.2
   for ws in simulation_ws catkin_ws; do
     echo "[rostest] $ws (catkin_make run_tests, one at a time)"
     (
@@ -57,6 +62,7 @@ run_rostests() {
   done
 }
 run_wall_bound() {
+  export ROS_HOSTNAME=127.0.0.3
   echo "[integration, real time] $WALL_BOUND"
   "${PYTEST[@]}" --basetemp="$RESULTS/wall-bound-tmp" --junitxml="$RESULTS/pytest-wall-bound.xml" \
     "$WALL_BOUND" > "$RESULTS/pytest-wall-bound.log" 2>&1

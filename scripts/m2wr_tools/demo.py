@@ -107,8 +107,7 @@ def run(args, session, paths):
     realtime = args.realtime or args.gui or args.web
     say("starting a ROS master on a free port")
     uri = session.start_master()
-    os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
-    os.environ.pop("ROS_IP", None)
+    session.join()
     say("master %s (logs in %s)" % (uri, session.log_dir))
     rospy.init_node("m2wr_demo", disable_signals=True)
     # it records and measures: lockstep need not wait for it (docs/lockstep.md)

@@ -134,8 +134,7 @@ class Rig:
         if config:
             session.env["ROS_PYTHON_LOG_CONFIG_FILE"] = config
         self.session = session
-        os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
-        os.environ.pop("ROS_IP", None)
+        session.join()
         import rospy
         rospy.init_node(NODE.lstrip("/"), disable_signals=True)
 

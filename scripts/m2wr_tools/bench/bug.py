@@ -223,7 +223,7 @@ def main(argv=None):
 
     def bench_runs():
         session.start_master()
-        os.environ.update(ROS_MASTER_URI=session.master_uri, ROS_HOSTNAME="localhost")
+        session.join()
         import rospy
         # before any world sets /use_sim_time: this node keeps wall time and never hears /clock
         rospy.init_node("m2wr_bench_bug", disable_signals=True)

@@ -393,7 +393,7 @@ def main(argv=None):
                 figures["engine"]["engine_step"]["x_real_time"],
                 figures["engine"]["scan"]["ms_mean"]))
         session.start_master()
-        os.environ.update(ROS_MASTER_URI=session.master_uri, ROS_HOSTNAME="localhost")
+        session.join()
         import rospy
         rospy.init_node("m2wr_bench", disable_signals=True)
         # it records and measures: lockstep need not wait for it (docs/lockstep.md)

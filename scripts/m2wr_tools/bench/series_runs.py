@@ -245,7 +245,7 @@ class SeriesSession:
 
     def __enter__(self):
         self.session.start_master()
-        os.environ.update(ROS_MASTER_URI=self.session.master_uri, ROS_HOSTNAME="localhost")
+        self.session.join()
         import rospy
         rospy.init_node("series_runs", disable_signals=True)
         self.watcher = Watcher()

@@ -3,9 +3,10 @@ the simulator (my_worlds launch_world.launch), the robot (m2wr_description spawn
 tutorial's controller (motion_plan obstacle_avoidance.py) and optionally rosbag, each a child
 process in a process group of its own with its output in <log_dir>/<name>.log.
 
-Every child gets ROS_MASTER_URI=http://localhost:<port> and ROS_HOSTNAME=localhost, and
+Every child gets ROS_MASTER_URI=http://<host>:<port> and ROS_HOSTNAME=<host>, and
 ROS_LOG_DIR=<log_dir>/ros; the caller's own ROS_MASTER_URI is never used, so a master the
-user runs is left alone. `stop()` ends the children (SIGINT, then SIGTERM, SIGKILL) and
+user runs is left alone. <host> is localhost, or the loopback address ROS_HOSTNAME names
+(`loopback_host`). `stop()` ends the children (SIGINT, then SIGTERM, SIGKILL) and
 checks that no process of the session is left (`processes.leftovers`).
 """
 import os
@@ -22,6 +23,19 @@ from ..names import (COMMAND_TOPIC, CONTROLLER_NODE, ROBOT_DESCRIPTION_PARAM, SC
                      TUTORIAL_CONTROLLER, WORLD_LAUNCH)
 
 
+def loopback_host():
+    """The address of the session's ROS graph: the loopback address that ROS_HOSTNAME names
+    (127.x.y.z), else localhost; never an address another machine can reach.
+
+    Why another loopback address at all: a master keeps the address of a node that ended
+    without unregistering (killed), and calls it when the node's topics change
+    (publisherUpdate, "shutdown"). On one address the kernel may have given that port to a
+    node of another ROS graph running beside it, which then connects to the wrong graph's
+    publishers. scripts/test.sh runs its background streams each on its own address."""
+    host = os.environ.get("ROS_HOSTNAME", "")
+    return host if re.fullmatch(r"127(\.\d{1,3}){3}", host) else "localhost"
+
+
 class SessionError(RuntimeError):
     """A step of the session failed; the message says which and why."""
 
@@ -32,6 +46,7 @@ class Session:
         self.log_dir = os.path.abspath(log_dir)
         os.makedirs(self.log_dir, exist_ok=True)
         self.port = None
+        self.host = "localhost"
         self.master_uri = None
         self.env = None
         self.children = {}                      # name -> processes.Child, in start order
@@ -53,10 +68,11 @@ class Session:
         XML-RPC server listens on every interface (roscpp binds it to 0.0.0.0 whatever
         ROS_HOSTNAME says); the master itself binds to localhost. Nothing here needs rosout:
         the demo and the batch read the controller's log lines from /rosout directly."""
+        self.host = loopback_host()
         for _ in range(attempts):
-            self.port = processes.free_port()
-            self.master_uri = "http://localhost:%d" % self.port
-            self.env = dict(os.environ, ROS_MASTER_URI=self.master_uri, ROS_HOSTNAME="localhost",
+            self.port = processes.free_port(self.host.replace("localhost", "127.0.0.1"))
+            self.master_uri = "http://%s:%d" % (self.host, self.port)
+            self.env = dict(os.environ, ROS_MASTER_URI=self.master_uri, ROS_HOSTNAME=self.host,
                             ROS_LOG_DIR=os.path.join(self.log_dir, "ros"))
             self.env.pop("ROS_IP", None)
             master = self._start("roscore", ["rosmaster", "--core", "-p", str(self.port)])
@@ -76,6 +92,11 @@ class Session:
             del self.children["roscore"]      # the port was taken meanwhile: try another
         raise SessionError("the ROS master would not start (%d attempts); last output:\n%s"
                            % (attempts, master.log_tail()))
+
+    def join(self):
+        """This process's own rospy node (init_node after this) joins the session's graph."""
+        os.environ.update(ROS_MASTER_URI=self.master_uri, ROS_HOSTNAME=self.host)
+        os.environ.pop("ROS_IP", None)
 
     def master(self):
         """The master's XML-RPC proxy; use it in a `with` block, which closes its socket."""

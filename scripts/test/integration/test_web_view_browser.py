@@ -36,8 +36,8 @@ def world(tmp_path_factory):
     probe = None
     saved = {k: os.environ.get(k) for k in ("ROS_MASTER_URI", "ROS_HOSTNAME")}
     try:
-        uri = session.start_master()
-        os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
+        session.start_master()
+        session.join()
         session.launch_world("world02", real_time_factor=1.0, lockstep=False,
                              extra=["web:=true", "web_port:=%d" % port])
         session.wait_for_simulator()
