@@ -13,6 +13,7 @@ import time
 import unittest
 
 import rosgraph
+import rosgraph.network
 import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -22,16 +23,18 @@ from pybullet_gazebo.ros.testing import wait_until   # noqa: E402
 EXIT_WITHIN = 5.0          # [s] wall from the kill to roslaunch's exit
 
 
-def free_port():
+def free_port(address):
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
+        probe.bind((address, 0))
         return probe.getsockname()[1]
 
 
 class SimulatorKilledTest(unittest.TestCase):
     def test_launch_ends_when_the_simulator_is_killed(self):
-        port = free_port()
-        master_uri = "http://localhost:%d/" % port
+        # where roslaunch's master will listen: ROS_HOSTNAME's address (scripts/test.sh gives
+        # the rostests a loopback address of their own), as rospy and rosmaster read it
+        port = free_port(rosgraph.network.get_bind_address())
+        master_uri = "http://%s:%d/" % (rosgraph.network.get_host_name(), port)
         env = dict(os.environ, ROS_MASTER_URI=master_uri)
         output = tempfile.TemporaryFile(mode="w+")
         launch = subprocess.Popen(["roslaunch", "-p", str(port), "my_worlds",
