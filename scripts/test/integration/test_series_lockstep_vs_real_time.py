@@ -99,8 +99,8 @@ def test_bug2_goes_round_a_pillar_in_lockstep_as_at_real_time(tmp_path):
     assert within_real_time_spread(first["time_to_goal_s"], times), \
         (first["time_to_goal_s"], times)
     if (first["time_to_goal_s"], first["end"]) != (second["time_to_goal_s"], second["end"]):
-        # a known defect (issue 36), seen once on 28 Nov (22.405 s and 22.655 s) after the
-        # handshake's races were fixed: bug 2's three processes switching each other by
-        # service calls still part now and then; to be found and this branch removed
+        # a known defect (issue 36): bug 2's three processes switching each other by service
+        # calls may still part now and then (seen once, 0.25 s apart, after the handshake's
+        # races were fixed); to be found and this branch removed
         pytest.xfail("bug 2's two lockstep runs differ: %r" % (
             [(r["time_to_goal_s"], r["end"]) for r in (first, second)],))
