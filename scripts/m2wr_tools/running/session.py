@@ -63,10 +63,11 @@ class Session:
         return self.children.get(name)
 
     def start_master(self, timeout=20.0, attempts=3):
-        """A ROS master on a free localhost port; returns its URI once it answers.
-        `rosmaster --core`, not roscore: roscore also starts rosout, a roscpp node whose
-        XML-RPC server listens on every interface (roscpp binds it to 0.0.0.0 whatever
-        ROS_HOSTNAME says); the master itself binds to localhost. Nothing here needs rosout:
+        """A ROS master on a free port of the session's loopback address (`loopback_host`);
+        returns its URI once it answers. `rosmaster --core`, not roscore: roscore also starts
+        rosout, a roscpp node whose XML-RPC server listens on every interface (roscpp binds
+        it to 0.0.0.0 whatever ROS_HOSTNAME says); the master itself binds to the loopback
+        address ROS_HOSTNAME gives it. Nothing here needs rosout:
         the demo and the batch read the controller's log lines from /rosout directly."""
         self.host = loopback_host()
         for _ in range(attempts):
