@@ -22,7 +22,10 @@ class SpawnWithoutSimulatorTest(unittest.TestCase):
         result = spawn("robot_description", "-y", "8")
         elapsed = time.monotonic() - started
         self.assertEqual(result.returncode, 1)
-        self.assertLess(elapsed, 14.0)           # 10 s of waiting plus start-up under load
+        self.assertIn("within 10 s", result.stderr)        # its own wait: the default 10 s
+        # it gives up, where Gazebo's client waits for ever; the bound leaves room for a
+        # Python start-up on a loaded machine (seen: 4.3 s beside the other test streams)
+        self.assertLess(elapsed, 30.0)
         self.assertIn("launch_world.launch", result.stderr)
         self.assertIn("start the world", result.stderr)
 
