@@ -260,15 +260,9 @@ class Session:
     def connected(self, node, topic, peer_node):
         """True when `node` has a live connection on `topic` with `peer_node` (from the
         node's getBusInfo)."""
-        uri, peer_uri = self.node_uri(node), self.node_uri(peer_node)
-        if uri is None or peer_uri is None:
-            return False
-        try:
-            with xmlrpc.client.ServerProxy(uri) as proxy:
-                code, _, bus = proxy.getBusInfo("/" + self.name)
-        except (OSError, xmlrpc.client.Error):
-            return False
-        if code != 1:
+        peer_uri = self.node_uri(peer_node)
+        _, bus = self._bus_info(node)
+        if peer_uri is None or not isinstance(bus, list):
             return False
         for connection in bus:
             # [id, destination (caller id or URI), direction, transport, topic, connected, ...]
@@ -277,19 +271,27 @@ class Session:
                 return True
         return False
 
-    def describe_connections(self, node):
-        """`node`'s address on the master and its live connections, as a line for an error
-        message (what a "did not connect" needs to be understood afterwards)."""
+    def _bus_info(self, node):
+        """(`node`'s XML-RPC address or None, its connections as getBusInfo lists them, or
+        a string saying why there are none to read)."""
         uri = self.node_uri(node)
         if uri is None:
-            return "%s: not registered on the master" % node
+            return None, "not registered on the master"
         try:
             with xmlrpc.client.ServerProxy(uri) as proxy:
                 code, _, bus = proxy.getBusInfo("/" + self.name)
         except (OSError, xmlrpc.client.Error) as error:
-            return "%s at %s: does not answer (%s)" % (node, uri, error)
-        if code != 1:
-            return "%s at %s: no bus information" % (node, uri)
+            return uri, "does not answer (%s)" % error
+        return (uri, bus) if code == 1 else (uri, "no bus information")
+
+    def describe_connections(self, node):
+        """`node`'s address on the master and its live connections, as a line for an error
+        message (what a "did not connect" needs to be understood afterwards)."""
+        uri, bus = self._bus_info(node)
+        if uri is None:
+            return "%s: not registered on the master" % node
+        if not isinstance(bus, list):
+            return "%s at %s: %s" % (node, uri, bus)
         # [id, destination, direction, transport, topic, connected, ...]
         return "%s at %s: %s" % (node, uri, ", ".join(sorted(
             "%s %s %s%s" % (c[4], c[2], c[1], "" if c[5] else " (not connected)")
