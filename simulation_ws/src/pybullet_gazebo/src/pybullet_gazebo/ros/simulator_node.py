@@ -45,7 +45,7 @@ from pybullet_gazebo.ros.clock_topic import ClockTopic
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
 from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.lockstep import REPORT_TOPIC, rospy_hooks
-from pybullet_gazebo.ros.lockstep.gate import Lockstep
+from pybullet_gazebo.ros.lockstep.gate import Lockstep, sort_controllers
 from pybullet_gazebo.ros.lockstep.idle_threads import IdleWatch
 from pybullet_gazebo.ros.lockstep.node_processes import MASTER, NodeProcesses
 from pybullet_gazebo.ros.lockstep.own_receivers import OwnReceivers
@@ -116,6 +116,8 @@ class SimulatorNode:
         self._handed_on = False                   # ... a tick went out inside this stretch
         self._watched_key = None                  # lockstep: the loop connections watched now
         self._watched_names = set()               # ... and their nodes
+        self._reporting = set()                   # ... of them, those that report
+        self._leaving = set()                     # reporters whose report connection closed
         self._bindings = {}                       # robot name -> RobotBindings
         self._running = False                     # run() is stepping
         self._tf_publisher = None
@@ -377,14 +379,16 @@ class SimulatorNode:
                        for pair in b.loop_connections()]
         reporters = self._reporters()
         self._watched_names = names = {node for node, _ in connections}
-        reporting = names & reporters
-        watched = names - reporting
+        reporting, watched, self._leaving = sort_controllers(
+            names, reporters, self._reporting, self._leaving)
+        self._reporting = reporting
         self.lockstep.wait_for(reporting, watched)
         self.lockstep.watch.watch(self._node_processes.find(watched))
         rospy.loginfo("lockstep: waits for %s%s", ", ".join(
             ["%s (handshake)" % n for n in sorted(reporting)] +
             ["%s (pid %s, watched in /proc: it sends no lockstep report)"
-             % (n, self._node_processes.pid_of(n)) for n in sorted(watched)])
+             % (n, self._node_processes.pid_of(n)) for n in sorted(watched)] +
+            ["%s (leaving: its report connection closed)" % n for n in sorted(self._leaving)])
             or "no controller", "; and %s (pid %s), which their service calls go through" % (
                 MASTER, self._node_processes.pid_of(MASTER)) if watched else "")
 

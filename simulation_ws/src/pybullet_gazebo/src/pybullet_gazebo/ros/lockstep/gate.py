@@ -18,6 +18,22 @@ and in the run summary.
 import time
 
 
+def sort_controllers(names, reporters, was_reporting, was_leaving):
+    """How lockstep waits for each controller `names` (the nodes on its loop connections),
+    given `reporters` (the nodes whose report connections are open now) and the previous
+    answer's reporting and leaving sets: (reporting, watched, leaving).
+
+    A node that ends closes its connections all at once, but the simulator sees them go one
+    by one: the report connection first (it reads from it, so the end of the stream shows at
+    once), those it writes to at its next write. A reporter that lost only its report
+    connection is leaving, not a controller without the handshake: it will say no more, and
+    it is not waited for at all (neither by reports nor in /proc) until it is gone or
+    reports again (a new process under its name)."""
+    reporting = names & reporters
+    leaving = (was_leaving | (was_reporting - reporters)) & (names - reporters)
+    return reporting, names - reporting - leaving, leaving
+
+
 class LockstepStats:
     """What lockstep cost in a run, for the simulator's run summary."""
 
