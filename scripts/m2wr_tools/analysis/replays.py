@@ -62,11 +62,14 @@ class _Wheels:
         now = []
         for k, (joint, link, axis, radius) in enumerate(self.wheels):
             state = client.getLinkState(body, link, computeForwardKinematics=True)
-            position = np.asarray(state[4])
-            world_axis = Pose((0, 0, 0), tuple(state[5])).matrix @ axis
-            rolls = np.cross(world_axis, (0.0, 0.0, 1.0))
-            if self.last is not None:
-                self.angles[k] += float(np.dot(position - self.last[k], rolls)) / radius
+            position = state[4]
+            # pybullet gives a joint's axis in its child's inertial frame (state[1]), which
+            # for m2wr's wheels is turned against the URDF link frame (state[5])
+            ax, ay, _ = Pose((0, 0, 0), tuple(state[1])).matrix @ axis
+            if self.last is not None:          # rolls along axis x z = (ay, -ax, 0)
+                before = self.last[k]
+                self.angles[k] += ((position[0] - before[0]) * ay
+                                   - (position[1] - before[1]) * ax) / radius
             client.resetJointState(body, joint, self.angles[k])
             now.append(position)
         self.last = now
@@ -84,6 +87,9 @@ def frames(scene, track, robot_links, period=FRAME_PERIOD, hits=REPLAY_HITS):
     builder = FrameBuilder(scene.world)
     wheels = _Wheels(scene.client, robot, robot_links)
     lasers = ray_sensors(robot)
+    # the offline scene never steps: the world's models stay where they are for the whole
+    # replay, and each frame shares their one reading
+    models = builder.moving_models()
     out = []
     for row in _sample(list(track), period):
         t = float(row[0])
@@ -91,7 +97,7 @@ def frames(scene, track, robot_links, period=FRAME_PERIOD, hits=REPLAY_HITS):
                                tuple(float(v) for v in row[4:8])))
         wheels.turn()
         frame = {"type": "frame", "t": round(t, 3), "rtf": None, "paused": False,
-                 "models": builder.moving_models(), "robots": {robot.name: builder.robot(robot)},
+                 "models": models, "robots": {robot.name: builder.robot(robot)},
                  "hits": {}}
         points, origin = [], None
         for sensor in lasers:
