@@ -19,10 +19,11 @@ depends only on its scenario:
   awaited (the next run's reset comes after it: none of its commands can reach
   that run).
 
-Per-run `stages` [s wall] in the record: reset_s, controller_start_s, sim_s, measure_s,
-stop_s; `overhead_s` = the run's wall time less sim_s's unpaused part; `cpu_s`: the CPU [s]
-of each process of the worker (this one, the simulator, its roslaunch, the master, the
-controller) per stage and in total (m2wr_tools.running.cpu_meter).
+Per-run `stages` [s wall] in the record: reset_s, controller_start_s, sim_s, measure_s (of
+which replay_s made the run's replay, when asked for), stop_s; `overhead_s` = the run's wall
+time less sim_s's unpaused part; `cpu_s`: the CPU [s] of each process of the worker (this
+one, the simulator, its roslaunch, the master, the controller) per stage and in total
+(m2wr_tools.running.cpu_meter).
 
 The simulator is kept between runs of the same world and seed (reuse) and relaunched
 otherwise (the seed is a launch argument), or before every run with reuse off. The world and
@@ -432,6 +433,8 @@ class Rig:
         if outcome is None and self.commands == 0:
             outcome = "the controller never published on %s; see %s" % (COMMAND_TOPIC, log_path)
         stage("measure_s")
+        if "_replay_s" in result:
+            stages["replay_s"] = result.pop("_replay_s")
         result["stages"] = stages
         result["_unpaused_wall_s"] = unpaused
         result["cmd_vel_messages"] = self.commands
@@ -604,7 +607,9 @@ class Rig:
         if options.picture:
             result["picture"] = self._picture(scenario, track, scene, runs_dir)
         if options.replay:
+            began = time.monotonic()
             result["replay"] = self._replay(scenario, track, scene, runs_dir)
+            result["_replay_s"] = round(time.monotonic() - began, 3)   # (in measure_s)
         return result
 
     def _replay(self, scenario, track, scene, runs_dir):

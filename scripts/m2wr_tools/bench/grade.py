@@ -15,7 +15,8 @@ copied in and out, the rules' last look, the end by PID). Medians: a worker's fi
 starts its simulator. The comparison is like for like: the class graded again on the spec's
 obstacle-avoider task alone (ep5, 60 s in world02, one seed), so that both workers run the
 same light controller as the batch runner's do, then the batch runner on the same program
-through scripts/evaluate.sh, from as many random free starts as the class had students; the
+through scripts/evaluate.sh, from as many random free starts as the class had students, each
+run's replay made by both (the grader's report shows it; its cost is the stage replay_s); the
 two in turn for --rounds rounds (the machine's speed drifts by more than the grader costs
 between minutes), each round's ratio printed and the ratio of all rounds' medians the
 figure. (In the whole class the other worker runs go to point, the wall follower and bug 2
@@ -182,7 +183,7 @@ def bench(args):
         _run([sys.executable, "-m", "m2wr_tools.batch.evaluate", "--controller", TUTORIAL,
               "--task", "wander", "--world", "world02", "--duration", str(DURATION),
               "--seeds", "0", "--random", str(max(2, len(names))), "--pose-seed", str(index),
-              "--output", evaluate_out, "--fresh", "--no-progress"] + workers,
+              "--replays", "--output", evaluate_out, "--fresh", "--no-progress"] + workers,
              "round %d of %d: the batch runner on the same controller"
              % (index + 1, args.rounds))
         with open(os.path.join(evaluate_out, "results.json")) as source:

@@ -85,6 +85,9 @@ def test_the_fixture_class_gets_the_grades_a_teacher_expects(tmp_path):
         assert rows[student]["total"] == "0.00" and rows[student]["rank"] == "3"
     data = json.loads((tmp_path / "out" / "results.json").read_text())
     gus = data["students"]["gus"]["runs"][0]
+    # each run that ran the world has its replay, made within its measuring (timed apart)
+    stages = gus["stages"]
+    assert os.path.isfile(gus["replay"]) and 0 < stages["replay_s"] <= stages["measure_s"]
     # his launch file's spawn is left out (the grader's m2wr is the one graded): no second
     # spawn reaches the simulator
     assert gus["findings"] == [] and [x["element"] for x in gus["left_out"]] == [
