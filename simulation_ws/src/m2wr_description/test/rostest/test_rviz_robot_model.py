@@ -37,21 +37,35 @@ class RvizRobotModelTest(unittest.TestCase):
         os.makedirs(folder, exist_ok=True)
         screenshot = os.path.join(folder, "rviz_robot_model.png")
         display = VirtualDisplay()
+        crashed = []
         try:
-            probe = subprocess.run(
-                [sys.executable, os.path.join(HERE, "rviz_probe.py"),
-                 os.path.join(package, "rviz", "m2wr.rviz"), "--seconds", "30",
-                 "--settle", "3", "--screenshot", screenshot],
-                env=dict(os.environ, DISPLAY=display.display), capture_output=True,
-                text=True, timeout=70)
+            # Debian's rviz (OGRE on Mesa's llvmpipe) can abort while it sets up OpenGL,
+            # before it reads the config (glibc's "corrupted size vs. prev_size", SIGABRT):
+            # not this package's doing, and not what this test is about. A probe that dies
+            # by a signal without a report is tried once more; both crashes are shown if
+            # the second one dies too
+            for _ in range(2):
+                probe = subprocess.run(
+                    [sys.executable, os.path.join(HERE, "rviz_probe.py"),
+                     os.path.join(package, "rviz", "m2wr.rviz"), "--seconds", "30",
+                     "--settle", "3", "--screenshot", screenshot],
+                    env=dict(os.environ, DISPLAY=display.display), capture_output=True,
+                    text=True, timeout=70)
+                # the probe's one JSON line; rviz's own ROS log lines go to stdout too, and
+                # one may come after it as rviz shuts down (seen on a loaded machine)
+                lines = [line for line in probe.stdout.splitlines()
+                         if line.startswith('{"ok"')]
+                if lines or probe.returncode >= 0:
+                    break
+                crashed.append("exit %s: %s" % (probe.returncode, probe.stderr[-500:]))
+                sys.stderr.write("rviz_probe.py crashed at start-up, tried again: %s\n"
+                                 % crashed[-1])
         finally:
             display.stop()
-        # the probe's one JSON line; rviz's own ROS log lines go to stdout too, and one may
-        # come after it as rviz shuts down (seen on a loaded machine)
-        lines = [line for line in probe.stdout.splitlines() if line.startswith('{"ok"')]
         self.assertTrue(lines, "rviz_probe.py printed no report (exit %s); stdout:\n%s\n"
-                        "stderr:\n%s" % (probe.returncode, probe.stdout[-3000:],
-                                         probe.stderr[-3000:]))
+                        "stderr:\n%s\nearlier crashes: %s" % (
+                            probe.returncode, probe.stdout[-3000:], probe.stderr[-3000:],
+                            crashed))
         report = json.loads(lines[-1])
         by_name = {d["name"]: d for d in report["displays"]}
         self.assertEqual(sorted(by_name), ["Grid", "LaserScan", "Odometry", "RobotModel", "TF"])
