@@ -168,6 +168,7 @@ while True:
 """
 RELAY_END = """
 import sys, time
+print("end ready", flush=True)
 for line in sys.stdin:
     end = time.thread_time() + 0.002
     while time.thread_time() < end:
@@ -183,6 +184,9 @@ def test_work_handed_on_between_threads_and_processes_is_waited_for_to_the_end()
     try:
         first = relay.stdout.readline().split()
         assert first[0] == "ready"
+        # both Pythons have started, as the other tests wait for their child's "ready": a
+        # start-up still at work when the watch first looks could be taken for a busy loop
+        assert relay.stdout.readline().strip() == "end ready"
         watch = IdleWatch()
         watch.watch([relay.pid, int(first[1])])
         assert settle(watch) is None
