@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test suite: scripts/setup.sh (if anything is missing), then in the background the
 # rostest suites of both workspaces through catkin and, beside them, the comparisons of
-# lockstep with real-time runs followed by the batch runner's failure and cluster cases; in
-# the foreground the unit tests (pytest, no ROS master) and
+# lockstep with real-time runs followed by the batch runner's failure and cluster cases and
+# the grader's fixture class; in the foreground the unit tests (pytest, no ROS master) and
 # then the other integration tests (pytest: the batch runner, the grader, lockstep, the
 # browser view). Results and logs go to test_results/.
 # Exits non-zero when any test fails or a rostest crashed without writing its results, and
