@@ -365,7 +365,8 @@ class SimulatorNode:
 
     def _watch_loop_nodes(self):
         """Lockstep waits for the loop nodes: by their reports when they send them (the
-        handshake), by the /proc watch of their processes otherwise. Both are asked again
+        handshake), by the /proc watch of their processes otherwise, and not at all for a
+        reporter on its way out (gate.sort_controllers). Both are asked again
         whenever the loop nodes' connections change (a node restarted under the same name,
         the batch runner's next controller, is a new process) or a node starts reporting."""
         # rospy replaces a topic's list of connections whenever one comes or goes: the
