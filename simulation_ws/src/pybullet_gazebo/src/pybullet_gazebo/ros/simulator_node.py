@@ -116,7 +116,6 @@ class SimulatorNode:
         self._handed_on = False                   # ... a tick went out inside this stretch
         self._watched_key = None                  # lockstep: the loop connections watched now
         self._watched_names = set()               # ... and their nodes
-        self._reporting = set()                   # ... of them, those that report
         self._leaving = set()                     # reporters whose report connection closed
         self._bindings = {}                       # robot name -> RobotBindings
         self._running = False                     # run() is stepping
@@ -381,8 +380,7 @@ class SimulatorNode:
         reporters = self._reporters()
         self._watched_names = names = {node for node, _ in connections}
         reporting, watched, self._leaving = sort_controllers(
-            names, reporters, self._reporting, self._leaving)
-        self._reporting = reporting
+            names, reporters, self.lockstep.reporting, self._leaving)
         self.lockstep.wait_for(reporting, watched)
         self.lockstep.watch.watch(self._node_processes.find(watched))
         rospy.loginfo("lockstep: waits for %s%s", ", ".join(
