@@ -5,9 +5,10 @@
 #   scripts/setup.sh --help   this text; installs and builds nothing
 #
 # Steps: Debian's ROS 1 packages -> .venv from /usr/bin/python3 (--system-site-packages, so
-# Debian's rospy stays importable) -> pinned PyPI packages -> the tools package (scripts/,
-# editable) -> catkin_make simulation_ws, then catkin_ws on top of it. Idempotent: on a ready
-# machine it only re-checks and re-runs the (incremental) catkin builds.
+# Debian's rospy stays importable) -> pinned PyPI packages and the tools package (scripts/,
+# editable), and beside them catkin_make simulation_ws, then catkin_ws on top of it -> the
+# ray caster compiled (numba) and the project byte-compiled. Idempotent: on a ready machine
+# it only re-checks and re-runs the (incremental) catkin builds.
 #
 # Exit status: 0 when the project is ready; 1 when a step failed (the step is named); 2 for an
 # unknown option.
@@ -27,8 +28,11 @@ STEP="start"
 
 say()  { printf '[setup] %s\n' "$*"; }
 fail() { printf '[setup] FAILED at step "%s": %s\n' "$STEP" "$*" >&2; exit 1; }
-kernel_pid=""
-trap 'rc=$?; [ -z "$kernel_pid" ] || kill "$kernel_pid" 2>/dev/null; [ $rc -eq 0 ] || printf "[setup] FAILED at step \"%s\" (exit %d); see the output above\n" "$STEP" "$rc" >&2' EXIT
+# what runs in the background (the catkin builds, numba's compile), stopped by PID with all
+# its children when the set-up ends early (a failed step, Ctrl-C)
+kernel_pid="" catkin_pid=""
+stop_tree() { local child; for child in $(pgrep -P "$1"); do stop_tree "$child"; done; kill "$1" 2>/dev/null || true; }
+trap 'rc=$?; for pid in $kernel_pid $catkin_pid; do stop_tree "$pid"; done; [ $rc -eq 0 ] || printf "[setup] FAILED at step \"%s\" (exit %d); see the output above\n" "$STEP" "$rc" >&2' EXIT
 
 # Debian's ROS 1 packages (Noetic-era ros_comm 1.15) the project needs at run, build and test time.
 APT_PACKAGES=(
@@ -94,6 +98,27 @@ else
   "$SYSTEM_PYTHON" -m venv --system-site-packages "$VENV"
 fi
 
+STEP="catkin build"
+export PATH="$VENV/bin:$PATH"        # catkin_make must find the venv's python3, not pyenv's
+unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH
+build_ws() {
+  local ws="$1"
+  say "3/4 catkin_make $ws"
+  (cd "$ROOT/$ws" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python3" \
+      -DCATKIN_ENABLE_TESTING=ON > "$ROOT/$ws/build.log" 2>&1) \
+    || { tail -n 40 "$ROOT/$ws/build.log" >&2; say "catkin_make in $ws failed; full log: $ws/build.log" >&2; return 1; }
+}
+build_workspaces() {
+  build_ws simulation_ws || return 1
+  # catkin_ws overlays simulation_ws, as in the tutorial's environment where both are sourced.
+  set +u; source "$ROOT/simulation_ws/devel/setup.bash"; set -u
+  build_ws catkin_ws
+}
+# The builds need Debian's catkin and the venv's interpreter, none of the PyPI packages: they
+# run beside pip's install (on a fresh machine each takes a good part of the set-up)
+build_workspaces &
+catkin_pid=$!
+
 STEP="PyPI packages"
 stamp="$VENV/.requirements.sha256"
 want="$(sha256sum "$ROOT/requirements.txt" | cut -d' ' -f1)"
@@ -133,28 +158,17 @@ if [ "$(cat "$site/m2wr_lockstep.pth" 2>/dev/null)" != "$hook" ]; then
   printf '%s\n' "$hook" > "$site/m2wr_lockstep.pth"
 fi
 
-STEP="catkin build"
-export PATH="$VENV/bin:$PATH"        # catkin_make must find the venv's python3, not pyenv's
-unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH
-build_ws() {
-  local ws="$1"
-  say "4/4 catkin_make $ws"
-  (cd "$ROOT/$ws" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python3" \
-      -DCATKIN_ENABLE_TESTING=ON > "$ROOT/$ws/build.log" 2>&1) \
-    || { tail -n 40 "$ROOT/$ws/build.log" >&2; fail "catkin_make in $ws failed; full log: $ws/build.log"; }
-}
 # numba compiles the laser's inner loop once and caches it beside its source; doing it here
-# keeps that second out of the first simulator start. It needs only the engine's source, not
-# the build, so it runs beside catkin_make (a ~10 s compile on a fresh clone, 2 cores).
+# keeps that second out of the first simulator start. It needs the engine's source and numba,
+# not the build, so it may end before the builds.
 kernel_log="$(mktemp)"
 PYTHONPATH="$ROOT/simulation_ws/src/pybullet_gazebo/src" "$VENV/bin/python" -c \
   "from pybullet_gazebo.engine import ray_kernel; print('%.1f' % ray_kernel.warm_up())" \
   > "$kernel_log" 2>&1 &
 kernel_pid=$!
-build_ws simulation_ws
-# catkin_ws overlays simulation_ws, as in the tutorial's environment where both are sourced.
-set +u; source "$ROOT/simulation_ws/devel/setup.bash"; set -u
-build_ws catkin_ws
+STEP="catkin build"
+catkin_status=0; wait "$catkin_pid" || catkin_status=$?; catkin_pid=""
+[ "$catkin_status" -eq 0 ] || fail "catkin_make failed (its output above)"
 
 STEP="ray caster compile"
 kernel_status=0; wait "$kernel_pid" || kernel_status=$?; kernel_pid=""
