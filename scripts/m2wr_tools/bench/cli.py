@@ -47,9 +47,9 @@ Figures:
                     /gazebo/model_states reader for a Gazebo tool or a learner's script. They
                     are watchers (clock_topic.py): /clock at Gazebo's rate but at most
                     max(watch_rate, /clock rate) per wall second. Not included: rviz's
-                    drawing. rviz itself (m2wr.rviz, Xvfb, Mesa's software GL) took 0.5-0.6
-                    of a core drawing at 30 fps whatever the simulator sends, on this 2-core
-                    machine more than all the stand-ins together (3-6 ms per sim s).
+                    drawing: rviz itself (m2wr.rviz, Xvfb, Mesa's software GL) draws at 30 fps
+                    whatever the simulator sends, and costs more than all the stand-ins
+                    together (docs/performance.md).
   --listeners-only  just the lockstep loop without and with the listeners, ROUNDS times in
                     turn: each round's ratio and the median, CPU per sim s of the simulator,
                     the controller and each listener (the most robust figure on a shared

@@ -383,7 +383,8 @@ def python_logging_config(env):
     (ROS_PYTHON_LOG_CONFIG_FILE if set; else the first python_logging.conf or .yaml in
     $ROS_HOME/config, $ROS_ETC_DIR, rosgraph's conf/), or None. Given to a node as
     ROS_PYTHON_LOG_CONFIG_FILE, it spares its init_node a crawl of ROS_PACKAGE_PATH for
-    rosgraph's folder (~50 ms of CPU a node, measured) and changes nothing else."""
+    rosgraph's folder (a walk of every package folder, at every node's start) and changes
+    nothing else."""
     if env.get("ROS_PYTHON_LOG_CONFIG_FILE"):
         return env["ROS_PYTHON_LOG_CONFIG_FILE"]
     import rospkg

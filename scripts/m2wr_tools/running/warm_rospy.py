@@ -12,8 +12,8 @@ busy thread at exit, are shortened:
 - rospy.signal_shutdown joins the registration thread, which notices the shutdown only
   when its 0.5 s wait on new publishers times out: here the shutdown wakes it at once
   (pybullet_gazebo.ros.quick_exit, which every node of the project's environment gets).
-  Meanwhile rospy's XML-RPC server thread, whose socket is closed, spins on it (0.2-0.3 s
-  of CPU a run, measured): the shorter exit ends that early too.
+  Meanwhile rospy's XML-RPC server thread, whose socket is closed, spins on it, using CPU
+  that the next run needs: the shorter exit ends that early too.
 - rospy.signal_shutdown ends with a 0.1 s sleep "until we get rid of all the extra threads"
   (rospy's comment), after its hooks have closed every connection: it lets daemon threads
   wind down before the interpreter's teardown, which a zygote child never does (it leaves

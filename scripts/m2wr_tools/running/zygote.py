@@ -2,8 +2,8 @@
 message modules a controller usually needs, and forks a fresh child per run which runs the
 controller's script as __main__, as `python SCRIPT ARGS` would.
 
-Starting a Python controller costs ~1-1.5 s of CPU on this machine, mostly imports (rospy,
-genpy, the message classes); a fork of a process that has them costs a few milliseconds.
+Most of what starting a Python controller costs is imports (rospy, genpy, the message
+classes): a second of CPU or more; a fork of a process that has them costs milliseconds.
 The child is still the user's unmodified program started afresh: its own process (and
 process group, so the batch stops it as it stops any controller), `sys.argv` = [SCRIPT,
 ARGS...], `sys.path[0]` = the script's folder, its own environment, stdin from /dev/null,

@@ -20,7 +20,8 @@ def test_a_reporter_is_waited_for_by_its_reports_and_a_silent_node_in_proc():
 
 def test_a_reporter_that_lost_only_its_report_connection_is_leaving_not_watched():
     # the simulator sees a dying node's report connection close before its scan connection
-    # (CI, 28 Nov: 0.4 s apart); it must not be taken for a node without the handshake
+    # (it reads the first and only writes the second); it must not be taken for a node
+    # without the handshake
     reporting, watched, leaving = sorted_after((["/a", "/b"], ["/a", "/b"]),
                                                (["/a", "/b"], ["/a"]))
     assert (reporting, watched, leaving) == ({"/a"}, set(), {"/b"})

@@ -176,7 +176,8 @@ class Viewer:
     # --- frames -------------------------------------------------------------------------
     def frame(self, sim_time, rtf, moving, robots, beams):
         # Each call waits for the render thread, which draws between calls: rendering is
-        # paused while the frame's changes go in (a frame of world02 took 0.26 s, 0.1 s so)
+        # paused while the frame's changes go in (changing shapes while the renderer reads
+        # them makes each frame take several times longer)
         with self._not_rendering():
             self._frame(sim_time, rtf, moving, robots, beams)
 

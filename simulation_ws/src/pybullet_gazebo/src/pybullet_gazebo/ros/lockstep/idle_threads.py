@@ -396,8 +396,8 @@ class IdleWatch:
         """Waits until every watched process is idle (None) or the monotonic clock reaches
         `deadline` or interrupted() is true (the (pid, tid) still busy). `busy`: what the
         look just before found at work (busy()'s answer), followed first: a second whole look
-        at once would find the same thread and cost as much as the controller's whole tick
-        (measured: 110-150 us of a ~550 us wait for a rospy.Rate loop's tick)."""
+        at once would find the same thread and cost a large part of the controller's whole
+        tick (a look reads every thread's state in /proc)."""
         if self._precise_thread != threading.get_ident():
             precise_sleeps()
             self._precise_thread = threading.get_ident()
