@@ -419,6 +419,16 @@ def test_the_class_table_gives_one_short_reason_a_failed_task(tmp_path):
     name, text, full = short[1]
     assert name == "goal" and len(full) == 2 and full[0].endswith("off the goal's direction")
     assert text == "did not reach the goal: turned away from the goal (4 runs), +1 other reason"
+    # a controller that cannot start: why, not its command line (that is in the task's head)
+    unstarted = [{"task": "avoid", "index": 0, "success": False, "reason": (
+        "controller 'roslaunch motion_plan bug0.launch des_x:=0 des_y:=-4': package "
+        "'motion_plan' (ann/motion_plan) has no launch file 'bug0.launch'")},
+        {"task": "goal", "index": 0, "success": False, "reason": (
+            "controller 'rosrun nav go.py': package 'nav' not found on ROS_PACKAGE_PATH; "
+            "hand in a package of that name")}]
+    assert [text for _, text, _ in scoring.short_failures(spec, unstarted)] == [
+        "cannot start: no launch file 'bug0.launch'",
+        "cannot start: package 'nav' not found on ROS_PACKAGE_PATH"]
 
 
 def test_a_goal_run_that_turned_away_is_told_so():

@@ -26,7 +26,7 @@ th{background:#eee;cursor:pointer}td.n{text-align:right}.fail{color:#a00}.ok{col
 .run{border:1px solid #ccc;margin:1em 0;padding:.5em}.run img{float:left;margin-right:1em}
 .run:after{content:"";display:block;clear:both}pre{background:#f6f6f6;padding:.5em;
 overflow-x:auto;max-height:20em}td.full{background:#dfd}td.part{background:#ffe9c0}
-td.none{background:#fdd}td.why{font-size:90%;max-width:40em}td.why div{white-space:nowrap;
+td.none{background:#fdd}td.why{font-size:90%}td.why div{max-width:26em;white-space:nowrap;
 overflow:hidden;text-overflow:ellipsis}.note{color:#555}"""
 SORT = """function sortBy(th){var t=th.closest('table'),b=t.tBodies[0],i=th.cellIndex,
 d=th.dataset.dir==='asc'?-1:1;th.dataset.dir=d===1?'asc':'desc';

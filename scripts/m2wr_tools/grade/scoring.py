@@ -20,6 +20,9 @@ import re
 
 SEE_LOG = re.compile(r";? see /\S+")
 MISSED = re.compile(r"^did not reach the goal \([^)]*\) within [0-9.]+ m: (.+)$")
+# a controller that could not start ("controller '<its command line>': <why>"): the command
+# is in the task's head, the why is what the teacher needs; a package's folder is on the page
+UNSTARTED = re.compile(r"^controller '[^']*': (?:package '[^']*' \([^)]*\) has )?([^;]+)")
 SHORT = 60                     # [characters] of a reason in the class table
 NO_NEARER = 0.2                # [m] a path that never came this much nearer its goal
 AWAY = 120.0                   # [deg] off the goal's bearing at the end: facing away
@@ -56,8 +59,9 @@ def _first_line(record):
 def short_failures(spec, records):
     """[(task name, short reason, full reasons)] of each failed task, in spec order: the
     distinct reasons of its failed runs (first lines, without log paths), the first one cut
-    to SHORT characters at a word (a missed goal: what went wrong, from goal_hint), "(N runs)" when more than one run failed and "+N other
-    reasons" when they differ."""
+    to SHORT characters at a word (a missed goal: what went wrong, from goal_hint; a controller
+    that cannot start: why, without its command line), "(N runs)" when more than one run
+    failed and "+N other reasons" when they differ."""
     out = []
     for task in spec.tasks:
         failed = [r for r in records if r.get("task") == task.name and not r.get("success")]
@@ -69,8 +73,11 @@ def short_failures(spec, records):
                 reasons.append(_first_line(r))
         short = reasons[0]
         missed = MISSED.match(short)
+        unstarted = UNSTARTED.match(short)
         if missed:          # the goal's figures are in the task's head: say what went wrong
             short = "did not reach the goal: " + missed.group(1).split(":")[0]
+        elif unstarted:
+            short = "cannot start: " + unstarted.group(1)
         if len(short) > SHORT:
             short = short[:SHORT].rsplit(" ", 1)[0].rstrip(",;:") + "\u2026"
         if len(failed) > 1:
