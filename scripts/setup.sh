@@ -32,7 +32,7 @@ fail() { printf '[setup] FAILED at step "%s": %s\n' "$STEP" "$*" >&2; exit 1; }
 # its children when the set-up ends early (a failed step, Ctrl-C)
 kernel_pid="" catkin_pid=""
 stop_tree() { local child; for child in $(pgrep -P "$1"); do stop_tree "$child"; done; kill "$1" 2>/dev/null || true; }
-trap 'rc=$?; for pid in $kernel_pid $catkin_pid; do stop_tree "$pid"; done; [ $rc -eq 0 ] || printf "[setup] FAILED at step \"%s\" (exit %d); see the output above\n" "$STEP" "$rc" >&2' EXIT
+trap 'rc=$?; for pid in $kernel_pid $catkin_pid; do stop_tree "$pid"; done; rm -f "${kernel_log:-}"; [ $rc -eq 0 ] || printf "[setup] FAILED at step \"%s\" (exit %d); see the output above\n" "$STEP" "$rc" >&2' EXIT
 
 # Debian's ROS 1 packages (Noetic-era ros_comm 1.15) the project needs at run, build and test time.
 APT_PACKAGES=(

@@ -177,7 +177,7 @@ class Viewer:
     def frame(self, sim_time, rtf, moving, robots, beams):
         # Each call waits for the render thread, which draws between calls: rendering is
         # paused while the frame's changes go in (changing shapes while the renderer reads
-        # them makes each frame take several times longer)
+        # them made a frame take more than twice as long)
         with self._not_rendering():
             self._frame(sim_time, rtf, moving, robots, beams)
 
