@@ -98,7 +98,7 @@ else
   "$SYSTEM_PYTHON" -m venv --system-site-packages "$VENV"
 fi
 
-STEP="catkin build"
+# catkin builds (their failures are told when they are awaited, at STEP "catkin build" below)
 export PATH="$VENV/bin:$PATH"        # catkin_make must find the venv's python3, not pyenv's
 unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH
 build_ws() {
@@ -161,7 +161,7 @@ fi
 # numba compiles the laser's inner loop once and caches it beside its source; doing it here
 # keeps that second out of the first simulator start. It needs the engine's source and numba,
 # not the build, so it may end before the builds.
-kernel_log="$(mktemp)"
+kernel_log="$(mktemp)"                # removed by the EXIT trap, whichever way the set-up ends
 PYTHONPATH="$ROOT/simulation_ws/src/pybullet_gazebo/src" "$VENV/bin/python" -c \
   "from pybullet_gazebo.engine import ray_kernel; print('%.1f' % ray_kernel.warm_up())" \
   > "$kernel_log" 2>&1 &
@@ -173,11 +173,10 @@ catkin_status=0; wait "$catkin_pid" || catkin_status=$?; catkin_pid=""
 STEP="ray caster compile"
 kernel_status=0; wait "$kernel_pid" || kernel_status=$?; kernel_pid=""
 if [ "$kernel_status" -ne 0 ]; then
-  cat "$kernel_log" >&2; rm -f "$kernel_log"
+  cat "$kernel_log" >&2
   fail "numba could not compile pybullet_gazebo/engine/ray_kernel.py (error above)"
 fi
 say "4/4 ray caster compiled or loaded from numba's cache in $(tail -n 1 "$kernel_log") s"
-rm -f "$kernel_log"
 
 STEP="byte-compile"
 # Every node, tool and test is a new Python process that imports the simulator and the tools.
