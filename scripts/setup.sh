@@ -73,8 +73,9 @@ fi
 
 STEP="Debian packages"
 # one dpkg-query for all of them (one per package took ~5 s); a package it does not know
-# is missing too
-installed=" $(dpkg-query -W -f='${Package} ${Status}\n' "${APT_PACKAGES[@]}" 2>/dev/null \
+# is missing too. dpkg-query exits 1 when any package was never installed, which is what a
+# fresh machine has: its status is not a failure here (pipefail would make it one)
+installed=" $( { dpkg-query -W -f='${Package} ${Status}\n' "${APT_PACKAGES[@]}" 2>/dev/null || true; } \
   | awk '$NF == "installed" && $(NF-1) == "ok" {printf "%s ", $1}')"
 missing=()
 for pkg in "${APT_PACKAGES[@]}"; do
