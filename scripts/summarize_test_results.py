@@ -48,14 +48,24 @@ def count(results_dir):
     return passed, failed, skipped, failures
 
 
-def why(element, lines=6):
-    """The reason a failed case gives (its message, else the end of its text), indented: CI
-    keeps only the end of the output, so the reason must be here, not only in the XML."""
+def why(element, lines=8):
+    """The reason a failed case gives, indented: CI keeps only the end of the output, so the
+    reason must be here, not only in the XML. pytest puts it in the message attribute and
+    at the end of its traceback; rosunit (rostest's Python tests) writes the assertion's
+    message first and the traceback after it, without the exception line, so there the
+    message is the text before the first frame. A long message keeps its first line (what
+    failed) and its end (the output it quotes ends with the error)."""
     text = (element.get("message") or "").strip()
     body = (element.text or "").strip()
+    if body and not body.startswith(("Traceback", '  File "')):
+        message, frame, _ = body.partition('\n  File "')
+        if frame:                                   # rosunit's layout
+            text, body = (text if text and text not in message else message).strip(), ""
     if body and (not text or text not in body):
         text = (text + "\n" + body).strip()
-    kept = [line for line in text.splitlines() if line.strip()][-lines:]
+    kept = [line for line in text.splitlines() if line.strip()]
+    if len(kept) > lines:
+        kept = kept[:1] + ["..."] + kept[-(lines - 2):]
     return "".join("\n    " + line[:300] for line in kept)
 
 
