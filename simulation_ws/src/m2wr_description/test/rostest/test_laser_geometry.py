@@ -5,11 +5,13 @@ The robot is spawned at the origin facing +x; its laser sits 0.15 m ahead of the
 frame, and the wall's face is the plane x = 2.15 m for |y| <= 3 m. A beam at world heading phi
 from the sensor at (sx, sy) meets that plane at (2.15 - sx) / cos(phi) when the hit point lies
 on the wall, and sees nothing (+inf, REP 117) otherwise."""
+import collections
 import math
 import unittest
 
 import rospy
 import rostest
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
 from pybullet_gazebo.ros.testing import model_pose, wait_for_message, wait_until_sim_time
@@ -57,6 +59,27 @@ class LaserGeometryTest(unittest.TestCase):
         self.assertAlmostEqual(self.x, 0.0, delta=0.05)
         self.assertAlmostEqual(self.y, 0.0, delta=0.05)
         self.assertAlmostEqual(self.yaw, 0.0, delta=0.02)
+
+    def test_clock_ticks_every_10_ms_of_sim_time(self):
+        """/clock at pub_clock_frequency 100 Hz, in sim time, as Gazebo sends it. Not rostest's
+        hztest: in a node with /use_sim_time, rospy's own /clock subscriber has queue_size 1
+        and any other /clock subscriber of the node shares its connection, so ticks that
+        arrive together (a busy machine) are dropped but the last, and a count of them
+        measures the machine. The spacing of the ticks that do arrive measures the simulator:
+        each a whole number of 10 ms after the last, and 10 ms the usual one."""
+        stamps = []
+        subscriber = rospy.Subscriber("/clock", Clock, lambda m: stamps.append(m.clock.to_sec()))
+        try:
+            wait_until_sim_time(rospy.get_time() + 5.0)
+        finally:
+            subscriber.unregister()
+        gaps = [b - a for a, b in zip(stamps, stamps[1:])]
+        self.assertGreater(len(gaps), 100, "too few /clock ticks in 5 s of sim time")
+        in_periods = [gap / 0.01 for gap in gaps]
+        odd = [g for g in in_periods if g < 0.95 or abs(g - round(g)) > 0.05]
+        self.assertFalse(odd, "/clock gaps that are not whole 10-ms periods: %s" % odd[:10])
+        usual, _ = collections.Counter(round(g) for g in in_periods).most_common(1)[0]
+        self.assertEqual(usual, 1, "the usual /clock gap is %d0 ms, not 10 ms" % usual)
 
     def test_every_beam_matches_the_wall_geometry(self):
         hits = open_beams = 0

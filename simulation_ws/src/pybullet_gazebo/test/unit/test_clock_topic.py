@@ -69,6 +69,29 @@ def test_at_real_time_a_watcher_gets_gazebos_cadence(monkeypatch):
         assert min(gaps) > 0.0099 and max(gaps) < 0.0101
 
 
+def run_two_robots(clock, wall, seconds):
+    """As the simulator's _clock_due sends /clock: every 2 steps counted from the last tick,
+    and a tick at each step with readings, here two robots' scans at 20 Hz, spawned at
+    different steps (phases 1 and 6 of every 10 steps). At real time."""
+    last = None
+    for k in range(int(round(seconds / STEP))):
+        wall.now += STEP
+        if k % 10 in (1, 6) or last is None or k - last >= 2:
+            clock.publish(rospy.Time.from_sec(k * STEP))
+            last = k
+
+
+def test_with_two_robots_scanning_at_different_phases_a_watcher_still_gets_100_hz(monkeypatch):
+    clock, wall, got = make_clock(monkeypatch)
+    run_two_robots(clock, wall, 10.0)
+    assert len(got["/reading_laser"]) == 1200              # ticks at 1, 3, 5, 6, 8, 10 of 10
+    for node in ("/rviz", "/robot_state_publisher"):
+        # one in each 10 ms of sim time: what Gazebo's 100 Hz gives in those 10 s
+        assert 999 <= len(got[node]) <= 1001
+        slots = [round(t * 1000) // 10 for t in got[node]]
+        assert len(set(slots)) == len(slots)
+
+
 def test_faster_than_real_time_a_watcher_is_held_to_the_wall_rate(monkeypatch):
     clock, wall, got = make_clock(monkeypatch, clock_rate=20.0, watch_rate=30.0)
     run(clock, wall, 300.0, 30.0)                          # 10 s of wall time

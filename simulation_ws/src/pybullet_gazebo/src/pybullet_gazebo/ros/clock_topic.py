@@ -39,6 +39,7 @@ class _Watcher:
     def __init__(self, wall_limit, clock):
         self.limit = WallRateLimit(wall_limit, clock)
         self.last = None                    # [s] sim time of the last tick it got
+        self.slot = None                    # the clock period that tick fell in
 
 
 class ClockTopic:
@@ -74,10 +75,14 @@ class ClockTopic:
             if not self._limited:
                 return True
             watcher = self._watcher(node)
-            since = math.inf if watcher.last is None else now - watcher.last
-            # at its sim-time rate (half a step of slack for float sums); a reset: at once
-            if (since >= 0.999 * self._period or since < 0) and watcher.limit.allow():
-                watcher.last = now
+            # the first tick of each clock period of sim time (a reset: a period not seen
+            # yet). Not "a period since the last one": the readings' ticks come between the
+            # regular ones (a second robot's scans at their own phase), and a tick one step
+            # after the last would then be refused and the next regular one too, 80 of 100
+            # a sim second for a watcher
+            slot = self._slot(now)
+            if slot != watcher.slot and watcher.limit.allow():
+                watcher.last, watcher.slot = now, slot
                 return True
             return False
 
@@ -101,11 +106,19 @@ class ClockTopic:
 
         def share(connection):
             if connection.endpoint_id in behind:
-                self._watchers[connection.endpoint_id].last = now
+                watcher = self._watchers[connection.endpoint_id]
+                watcher.last, watcher.slot = now, self._slot(now)
                 return True
             return False
 
         self.publisher.publish(self._latest, share)
+
+    def _slot(self, sim_time):
+        """The number of the clock period `sim_time` [s] falls in (a millionth of a period's
+        slack for float sums of the step); every tick its own with no period."""
+        if self._period <= 0:
+            return sim_time
+        return math.floor(sim_time / self._period + 1e-6)
 
     def _watcher(self, node):
         watcher = self._watchers.get(node)
