@@ -57,7 +57,8 @@ def recorded(path):
         while True:
             try:
                 messages.append(pickle.load(source))
-            except EOFError:
+            except (EOFError, pickle.UnpicklingError):
+                # the end, or a message cut short: close() ends the viewer at once
                 return messages
 
 

@@ -122,15 +122,16 @@ class GuiWindow:
                 self._process.stdin.close()
             except OSError:
                 pass
+        # Ended at once, not left to read to the end of its stdin: a viewer still building
+        # the world in software GL took seconds to get there, and the simulator, which waits
+        # for it, ended that late after a Ctrl-C (over 10 s on a busy machine). SIGTERM ends
+        # it at once (viewer.py), and there is nothing of it to save.
+        self._process.terminate()
         try:
-            self._process.wait(3.0)
+            self._process.wait(2.0)
         except subprocess.TimeoutExpired:
-            self._process.terminate()
-            try:
-                self._process.wait(2.0)
-            except subprocess.TimeoutExpired:
-                self._process.kill()
-                self._process.wait()
+            self._process.kill()
+            self._process.wait()
 
     # --- frames -------------------------------------------------------------------------
     def _build_frame(self, now):
