@@ -17,10 +17,15 @@ AssertionError: unexpectedly None : goal (0.0, -3.0): nearest 0.912 m, not reach
 </testsuite>"""
 
 
+def summarize(folder, name, xml):
+    """The script run on a folder holding one result file `name` with `xml` in it."""
+    (folder / name).write_text(xml)
+    return subprocess.run([sys.executable, str(SCRIPT), str(folder)], capture_output=True,
+                          text=True)
+
+
 def test_a_failure_is_printed_with_its_reason(tmp_path):
-    (tmp_path / "rosunit-bug2.xml").write_text(RESULT)
-    run = subprocess.run([sys.executable, str(SCRIPT), str(tmp_path)], capture_output=True,
-                         text=True)
+    run = summarize(tmp_path, "rosunit-bug2.xml", RESULT)
     assert run.returncode == 1
     lines = run.stdout.splitlines()
     assert lines[0] == "FAILED: Bug2Test.test_reaches_the_goal (rosunit-bug2.xml)"
@@ -49,9 +54,7 @@ ImportError: the last line of the probe's error
 
 
 def test_a_rosunit_failure_shows_its_message_not_its_traceback(tmp_path):
-    (tmp_path / "rosunit-rviz.xml").write_text(ROSUNIT_RESULT)
-    run = subprocess.run([sys.executable, str(SCRIPT), str(tmp_path)], capture_output=True,
-                         text=True)
+    run = summarize(tmp_path, "rosunit-rviz.xml", ROSUNIT_RESULT)
     assert run.returncode == 1
     assert "rviz_probe.py printed no report (exit 1)" in run.stdout
     assert "ImportError: the last line of the probe's error" in run.stdout
