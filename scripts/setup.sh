@@ -6,8 +6,8 @@
 #
 # Steps: Debian's ROS 1 packages -> .venv from /usr/bin/python3 (--system-site-packages, so
 # Debian's rospy stays importable) -> pinned PyPI packages and the tools package (scripts/,
-# editable), and beside them catkin_make simulation_ws, then catkin_ws on top of it -> the
-# ray caster compiled (numba) and the project byte-compiled. Idempotent: on a ready machine
+# editable) -> catkin_make simulation_ws, then catkin_ws on top of it, and beside them the
+# ray caster compiled (numba) -> the project byte-compiled. Idempotent: on a ready machine
 # it only re-checks and re-runs the (incremental) catkin builds.
 #
 # Exit status: 0 when the project is ready; 1 when a step failed (the step is named); 2 for an
@@ -99,26 +99,8 @@ else
   "$SYSTEM_PYTHON" -m venv --system-site-packages "$VENV"
 fi
 
-# catkin builds (their failures are told when they are awaited, at STEP "catkin build" below)
 export PATH="$VENV/bin:$PATH"        # catkin_make must find the venv's python3, not pyenv's
 unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH
-build_ws() {
-  local ws="$1"
-  say "3/4 catkin_make $ws"
-  (cd "$ROOT/$ws" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python3" \
-      -DCATKIN_ENABLE_TESTING=ON > "$ROOT/$ws/build.log" 2>&1) \
-    || { tail -n 40 "$ROOT/$ws/build.log" >&2; say "catkin_make in $ws failed; full log: $ws/build.log" >&2; return 1; }
-}
-build_workspaces() {
-  build_ws simulation_ws || return 1
-  # catkin_ws overlays simulation_ws, as in the tutorial's environment where both are sourced.
-  set +u; source "$ROOT/simulation_ws/devel/setup.bash"; set -u
-  build_ws catkin_ws
-}
-# The builds need Debian's catkin and the venv's interpreter, none of the PyPI packages: they
-# run beside pip's install (on a fresh machine each takes a good part of the set-up)
-build_workspaces &
-catkin_pid=$!
 
 STEP="PyPI packages"
 stamp="$VENV/.requirements.sha256"
@@ -158,6 +140,27 @@ if [ "$(cat "$site/m2wr_lockstep.pth" 2>/dev/null)" != "$hook" ]; then
   say "3/4 lockstep hook: writing $site/m2wr_lockstep.pth"
   printf '%s\n' "$hook" > "$site/m2wr_lockstep.pth"
 fi
+
+# catkin builds, in the background (their failures are told when they are awaited, at STEP
+# "catkin build" below). They need Debian's catkin and the venv's interpreter, none of the
+# PyPI packages, but they start only once pip is done with the venv: their generators run that
+# interpreter, which sees the venv's packages, and one imported while pip was still writing
+# it (PyYAML, pulled in by distributed) died of a bus error in a fresh clone.
+build_ws() {
+  local ws="$1"
+  say "3/4 catkin_make $ws"
+  (cd "$ROOT/$ws" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python3" \
+      -DCATKIN_ENABLE_TESTING=ON > "$ROOT/$ws/build.log" 2>&1) \
+    || { tail -n 40 "$ROOT/$ws/build.log" >&2; say "catkin_make in $ws failed; full log: $ws/build.log" >&2; return 1; }
+}
+build_workspaces() {
+  build_ws simulation_ws || return 1
+  # catkin_ws overlays simulation_ws, as in the tutorial's environment where both are sourced.
+  set +u; source "$ROOT/simulation_ws/devel/setup.bash"; set -u
+  build_ws catkin_ws
+}
+build_workspaces &
+catkin_pid=$!
 
 # numba compiles the laser's inner loop once and caches it beside its source; doing it here
 # keeps that second out of the first simulator start. It needs the engine's source and numba,
