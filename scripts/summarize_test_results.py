@@ -57,10 +57,10 @@ def why(element, lines=8):
     failed) and its end (the output it quotes ends with the error)."""
     text = (element.get("message") or "").strip()
     body = (element.text or "").strip()
-    if body and not body.startswith(("Traceback", '  File "')):
+    if not text and body and not body.startswith(("Traceback", '  File "')):
         message, frame, _ = body.partition('\n  File "')
-        if frame:                                   # rosunit's layout
-            text, body = (text if text and text not in message else message).strip(), ""
+        if frame:                                   # rosunit's layout (it sets no message)
+            text, body = message.strip(), ""
     if body and (not text or text not in body):
         text = (text + "\n" + body).strip()
     kept = [line for line in text.splitlines() if line.strip()]

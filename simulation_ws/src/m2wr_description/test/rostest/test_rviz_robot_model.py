@@ -37,7 +37,7 @@ class RvizRobotModelTest(unittest.TestCase):
         os.makedirs(folder, exist_ok=True)
         screenshot = os.path.join(folder, "rviz_robot_model.png")
         display = VirtualDisplay()
-        crashed = []
+        unreported = []
         try:
             # Debian's rviz (OGRE on Mesa's llvmpipe) can abort while it sets up OpenGL,
             # before it reads the config (glibc's "corrupted size vs. prev_size", SIGABRT):
@@ -57,14 +57,14 @@ class RvizRobotModelTest(unittest.TestCase):
                          if line.startswith('{"ok"')]
                 if lines:
                     break
-                crashed.append("exit %s: %s" % (probe.returncode, probe.stderr[-500:]))
+                unreported.append("exit %s: %s" % (probe.returncode, probe.stderr[-500:]))
                 sys.stderr.write("rviz_probe.py ended without a report, tried again: %s\n"
-                                 % crashed[-1])
+                                 % unreported[-1])
         finally:
             display.stop()
         self.assertTrue(lines, "rviz_probe.py printed no report in %d attempts; the "
                         "last one's stdout:\n%s\nattempts (exit status: end of stderr):\n%s"
-                        % (len(crashed), probe.stdout[-2000:], "\n".join(crashed)))
+                        % (len(unreported), probe.stdout[-2000:], "\n".join(unreported)))
         report = json.loads(lines[-1])
         by_name = {d["name"]: d for d in report["displays"]}
         self.assertEqual(sorted(by_name), ["Grid", "LaserScan", "Odometry", "RobotModel", "TF"])
