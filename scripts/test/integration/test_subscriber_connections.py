@@ -25,6 +25,7 @@ PROGRAM = textwrap.dedent("""
     import rospy
     from rospy.impl.registration import RegManager, get_registration_listeners
     from std_msgs.msg import String
+    from pybullet_gazebo.ros.testing import wait_until
     if sys.argv[1] == "once":
         from pybullet_gazebo.ros.subscriber_connections import connect_each_publisher_once
         connect_each_publisher_once()
@@ -55,12 +56,17 @@ PROGRAM = textwrap.dedent("""
             thread.start()
         for thread in threads:
             thread.join()
-    time.sleep(1.0)                       # the master's updates and their connects
-    for publisher in publishers:
-        publisher.publish(String(data="once"))
-    time.sleep(1.0)
-    print(json.dumps({"accepted": accepted, "heard": heard}), flush=True)
-    rospy.signal_shutdown("done")
+    try:                                  # (a loaded machine connects slowly)
+        wait_until(lambda: len(heard) == len(topics), 30, "a greeting on every topic")
+        time.sleep(1.0)                   # the master's own updates and their connects
+        for publisher in publishers:
+            publisher.publish(String(data="once"))
+        wait_until(lambda: all(heard.get(t, 0) >= 2 for t in topics), 30,
+                   "the last message on every topic")
+        time.sleep(0.5)                   # a copy too many would come by now
+        print(json.dumps({"accepted": accepted, "heard": heard}), flush=True)
+    finally:
+        rospy.signal_shutdown("done")     # (rospy's threads would keep the process)
 """)
 
 
