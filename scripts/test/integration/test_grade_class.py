@@ -168,6 +168,9 @@ defaults:
   world: world02
   legacy_mode: {legacy_mode}
 tasks:
+"""
+SERIES_TASKS = {                 # each graded with the spec above: its text in the spec's list
+    "ep6_go_to_point": """\
   - name: ep6_go_to_point
     command: rosrun motion_plan go_to_point.py
     kind: goal
@@ -179,6 +182,8 @@ tasks:
       - call: /go_to_point_switch
         request: "data: true"
         if_offered: true
+""",
+    "ep7_follow_wall": """\
   - name: ep7_follow_wall
     command: rosrun motion_plan follow_wall.py
     kind: wall
@@ -188,6 +193,8 @@ tasks:
       - call: /wall_follower_switch
         request: "data: true"
         if_offered: true
+""",
+    "ep9_bug1": """\
   - name: ep9_bug1
     command: roslaunch motion_plan bug1.launch initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
     kind: goal
@@ -197,23 +204,37 @@ tasks:
     duration: 90
     points: 15
     allow: [set_model_state_to_start]
-"""
+""",
+    "ep10_bug2": """\
+  - name: ep10_bug2
+    command: roslaunch motion_plan bug2.launch initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
+    kind: goal
+    world: {pillar}
+    starts: [[3.5, -3.5, 0]]
+    goal: [3.5, 3.5]
+    duration: 60
+    points: 20
+    allow: [set_model_state_to_start]
+""",
+}
 PILLAR = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "test", "worlds",
                       "pillar_on_the_line.world")
 
 
-def _series_grades(tmp_path, legacy_mode, students):
+def _series_grades(tmp_path, legacy_mode, students, tasks):
     """The `students` of the series class (fixtures/series_class: kim, the series' final
     package written for Kinetic's turning; noa, its copy flipped for Noetic's; lee, kim's
-    programs with the world and the robot in her bug1.launch) graded with the spec above;
-    (rows of grades.csv, runs by (student, task), the output folder)."""
+    programs with the world and the robot in her bug1.launch, and her own world launch in
+    her bug2.launch) graded on `tasks` (SERIES_TASKS); (rows of grades.csv, runs by
+    (student, task), the output folder)."""
     class_dir = tmp_path / ("class_%s" % legacy_mode)
     for student in students:
         shutil.copytree(os.path.join(FIXTURES, "series_class", student),
                         class_dir / student)                     # links followed
     os.chmod(class_dir, 0o700)
     spec = tmp_path / ("series_%s.yaml" % legacy_mode)
-    spec.write_text(SERIES_SPEC.format(legacy_mode=str(legacy_mode).lower(), pillar=PILLAR))
+    spec.write_text(SERIES_SPEC.format(legacy_mode=str(legacy_mode).lower()) +
+                    "".join(SERIES_TASKS[task].format(pillar=PILLAR) for task in tasks))
     output = tmp_path / ("out_%s" % legacy_mode)
     status, text = grade(class_dir, output, spec=str(spec), timeout=900)
     assert status == 0, text
@@ -228,43 +249,58 @@ def _series_grades(tmp_path, legacy_mode, students):
 def test_the_series_final_packages_are_graded_with_the_turning_they_were_written_for(tmp_path):
     """The series' final behaviours start switched off: the spec's after_start switches them
     on as the pages do. Graded with legacy_mode true, kim's package (written for Kinetic's
-    turning) scores go to point, wall following and bug 1. lee's bug1.launch starts a world
-    and spawns m2wr: that part is left out, her page says what and why, and her run is kim's
-    to the bit (the grader's world was not touched). With legacy_mode false, the other way
-    round: noa's copy (flipped for Noetic's turning) scores, and kim's turns away from the
-    goal, which the page and the class table say. Bug 1 goes round a pillar on its line (from
-    (3.5, -3.5), placed facing east, to (3.5, 3.5)): under the other convention its go to
-    point turns away on the spot, and the reason says so. (noa under legacy_mode true is the
-    mirror of kim under false, and is not graded: three runs, one of 90 s of sim, saved.)"""
-    rows, runs, output = _series_grades(tmp_path, True, students=("kim", "lee"))
+    turning) scores go to point, wall following, bug 1 and bug 2. lee's launch files start a
+    world and spawn m2wr (bug1.launch by gazebo_ros's and m2wr_description's launch files,
+    bug2.launch through a world launch of her own, which includes my_worlds' and spawns
+    m2wr itself): those parts are left out, her page says what and why, and her runs are
+    kim's to the bit (the grader's world was not touched). With legacy_mode false, the other
+    way round: noa's copy (flipped for Noetic's turning) scores, and kim's go to point and
+    bug 2 turn away from the goal, which the page and the class table say. Bug 1 and bug 2
+    go round a pillar on their line (from (3.5, -3.5), placed facing east, to (3.5, 3.5)):
+    under the other convention go to point turns away on the spot. (noa under legacy_mode
+    true is the mirror of kim under false, and is not graded; bug 1 is graded under true
+    only: its go to point is the one bug 2 shows turning away. Bug 0, up to 150 s of sim in
+    world02, is left out for the suite's time.)"""
+    rows, runs, output = _series_grades(
+        tmp_path, True, ("kim", "lee"),
+        ("ep6_go_to_point", "ep7_follow_wall", "ep9_bug1", "ep10_bug2"))
     scores = {s: [float(rows[s][t]) for t in ("ep6_go_to_point", "ep7_follow_wall",
-                                              "ep9_bug1")] for s in rows}
-    assert scores["kim"] == [15.0, 15.0, 15.0], rows["kim"]
-    assert scores["lee"] == [15.0, 15.0, 15.0], rows["lee"]
+                                              "ep9_bug1", "ep10_bug2")] for s in rows}
+    assert scores["kim"] == [15.0, 15.0, 15.0, 20.0], rows["kim"]
+    assert scores["lee"] == [15.0, 15.0, 15.0, 20.0], rows["lee"]
     assert runs["kim", "ep6_go_to_point"]["after_start"] == [
         "called /go_to_point_switch (data: true): success: True, message: Done!"]
-    kim, lee = runs["kim", "ep9_bug1"], runs["lee", "ep9_bug1"]
-    assert [(x["element"], x["why"].split(";")[0]) for x in lee["left_out"]] == [
-        ('<include file="$(find gazebo_ros)/launch/empty_world.launch">',
-         "it starts a simulator or a world"),
-        ('<include file="$(find m2wr_description)/launch/spawn.launch">',
-         "it spawns the robot again")]
-    assert kim["left_out"] == []
-    for key in ("path", "time_to_goal_s", "final_x", "final_y", "contact_events"):
-        assert lee[key] == kim[key], key
+    left_out = {
+        "ep9_bug1": [('<include file="$(find gazebo_ros)/launch/empty_world.launch">',
+                      "it starts a simulator or a world"),
+                     ('<include file="$(find m2wr_description)/launch/spawn.launch">',
+                      "it spawns the robot again")],
+        "ep10_bug2": [('<include file="$(find my_worlds)/launch/world.launch">',
+                       "it starts a simulator or a world"),
+                      ('<param name="robot_description">', "the robot's description"),
+                      ('<node pkg="gazebo_ros" type="spawn_model" name="mybot_spawn">',
+                       "it spawns the robot again")]}
+    for task, elements in left_out.items():
+        kim, lee = runs["kim", task], runs["lee", task]
+        assert [(x["element"], x["why"].split(";")[0]) for x in lee["left_out"]] == elements
+        assert kim["left_out"] == []
+        for key in ("path", "time_to_goal_s", "final_x", "final_y", "contact_events"):
+            assert lee[key] == kim[key], (task, key)
     page = (output / "students" / "lee.html").read_text()
     assert "Left out of the launch files" in page and \
-        "$(find gazebo_ros)/launch/empty_world.launch" in page
+        "$(find gazebo_ros)/launch/empty_world.launch" in page and \
+        "$(find my_worlds)/launch/world.launch" in page
     assert "legacy_mode true: Kinetic&#x27;s diff drive" in page
     assert "Turning: <b>legacy_mode true" in (output / "index.html").read_text()
 
     # (lee is graded once: her runs are kim's to the bit, shown above)
-    rows, runs, output = _series_grades(tmp_path, False, students=("kim", "noa"))
+    rows, runs, output = _series_grades(
+        tmp_path, False, ("kim", "noa"), ("ep6_go_to_point", "ep7_follow_wall", "ep10_bug2"))
     scores = {s: [float(rows[s][t]) for t in ("ep6_go_to_point", "ep7_follow_wall",
-                                              "ep9_bug1")] for s in rows}
-    assert scores["noa"] == [15.0, 15.0, 15.0], rows["noa"]
+                                              "ep10_bug2")] for s in rows}
+    assert scores["noa"] == [15.0, 15.0, 20.0], rows["noa"]
     assert scores["kim"][0] == 0.0 and scores["kim"][2] == 0.0, rows["kim"]
-    for task, goal in (("ep6_go_to_point", "(2.00, 8.00)"), ("ep9_bug1", "(3.50, 3.50)")):
+    for task, goal in (("ep6_go_to_point", "(2.00, 8.00)"), ("ep10_bug2", "(3.50, 3.50)")):
         reason = runs["kim", task]["reason"]
         assert reason.startswith("did not reach the goal %s within 0.30 m: turned away from "
                                  "the goal" % goal), reason
@@ -272,7 +308,7 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     index = (output / "index.html").read_text()
     assert "Turning: <b>legacy_mode false" in index
     # one short line per failed task in the table, the whole reason in its tooltip
-    for task in ("ep6_go_to_point", "ep9_bug1"):
+    for task in ("ep6_go_to_point", "ep10_bug2"):
         assert '%s</a>: did not reach the goal: turned away from the goal</div>' % task \
             in index, task
     assert 'title="did not reach the goal (2.00, 8.00) within 0.30 m: turned away' in index
