@@ -261,11 +261,9 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     true is the mirror of kim under false, and is not graded; bug 1 is graded under true
     only: its go to point is the one bug 2 shows turning away. Bug 0, up to 150 s of sim in
     world02, is left out for the suite's time.)"""
-    rows, runs, output = _series_grades(
-        tmp_path, True, ("kim", "lee"),
-        ("ep6_go_to_point", "ep7_follow_wall", "ep9_bug1", "ep10_bug2"))
-    scores = {s: [float(rows[s][t]) for t in ("ep6_go_to_point", "ep7_follow_wall",
-                                              "ep9_bug1", "ep10_bug2")] for s in rows}
+    tasks = ("ep6_go_to_point", "ep7_follow_wall", "ep9_bug1", "ep10_bug2")
+    rows, runs, output = _series_grades(tmp_path, True, ("kim", "lee"), tasks)
+    scores = {s: [float(rows[s][t]) for t in tasks] for s in rows}
     assert scores["kim"] == [15.0, 15.0, 15.0, 20.0], rows["kim"]
     assert scores["lee"] == [15.0, 15.0, 15.0, 20.0], rows["lee"]
     assert runs["kim", "ep6_go_to_point"]["after_start"] == [
@@ -294,10 +292,9 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     assert "Turning: <b>legacy_mode true" in (output / "index.html").read_text()
 
     # (lee is graded once: her runs are kim's to the bit, shown above)
-    rows, runs, output = _series_grades(
-        tmp_path, False, ("kim", "noa"), ("ep6_go_to_point", "ep7_follow_wall", "ep10_bug2"))
-    scores = {s: [float(rows[s][t]) for t in ("ep6_go_to_point", "ep7_follow_wall",
-                                              "ep10_bug2")] for s in rows}
+    tasks = ("ep6_go_to_point", "ep7_follow_wall", "ep10_bug2")
+    rows, runs, output = _series_grades(tmp_path, False, ("kim", "noa"), tasks)
+    scores = {s: [float(rows[s][t]) for t in tasks] for s in rows}
     assert scores["noa"] == [15.0, 15.0, 20.0], rows["noa"]
     assert scores["kim"][0] == 0.0 and scores["kim"][2] == 0.0, rows["kim"]
     for task, goal in (("ep6_go_to_point", "(2.00, 8.00)"), ("ep10_bug2", "(3.50, 3.50)")):
