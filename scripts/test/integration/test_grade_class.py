@@ -194,6 +194,17 @@ SERIES_TASKS = {                 # each graded with the spec above: its text in 
         request: "data: true"
         if_offered: true
 """,
+    "ep8_bug0": """\
+  - name: ep8_bug0
+    command: roslaunch motion_plan bug0.launch initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
+    kind: goal
+    world: {pillar}
+    starts: [[3.5, -3.5, 0]]
+    goal: [3.5, 3.5]
+    duration: 60
+    points: 15
+    allow: [set_model_state_to_start]
+""",
     "ep9_bug1": """\
   - name: ep9_bug1
     command: roslaunch motion_plan bug1.launch initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
@@ -249,25 +260,28 @@ def _series_grades(tmp_path, legacy_mode, students, tasks):
 def test_the_series_final_packages_are_graded_with_the_turning_they_were_written_for(tmp_path):
     """The series' final behaviours start switched off: the spec's after_start switches them
     on as the pages do. Graded with legacy_mode true, kim's package (written for Kinetic's
-    turning) scores go to point, wall following, bug 1 and bug 2. lee's launch files start a
-    world and spawn m2wr (bug1.launch by gazebo_ros's and m2wr_description's launch files,
+    turning) scores go to point, wall following and bug 0, 1 and 2. lee's launch files start
+    a world and spawn m2wr (bug1.launch by gazebo_ros's and m2wr_description's launch files,
     bug2.launch through a world launch of her own, which includes my_worlds' and spawns
     m2wr itself): those parts are left out, her page says what and why, and her runs are
-    kim's to the bit (the grader's world was not touched). With legacy_mode false, the other
-    way round: noa's copy (flipped for Noetic's turning) scores, and kim's go to point and
-    bug 2 turn away from the goal, which the page and the class table say. Bug 1 and bug 2
-    go round a pillar on their line (from (3.5, -3.5), placed facing east, to (3.5, 3.5)):
-    under the other convention go to point turns away on the spot. (noa under legacy_mode
-    true is the mirror of kim under false, and is not graded; bug 1 is graded under true
-    only: its go to point is the one bug 2 shows turning away. Bug 0, up to 150 s of sim in
-    world02, is left out for the suite's time.)"""
-    tasks = ("ep6_go_to_point", "ep7_follow_wall", "ep9_bug1", "ep10_bug2")
+    kim's to the bit (the grader's world was not touched); she handed in no bug0.launch,
+    and her page says so. With legacy_mode false, the other way round: noa's copy (flipped
+    for Noetic's turning) scores the same, and kim's go to point and bug 0-2 turn away from
+    the goal, which the page and the class table say. Bug 0-2 go round a pillar on their
+    line (from (3.5, -3.5), placed facing east, to (3.5, 3.5)): under the other convention
+    go to point turns away on the spot. (noa under legacy_mode true is the mirror of kim
+    under false, and is not graded.)"""
+    tasks = ("ep6_go_to_point", "ep7_follow_wall", "ep8_bug0", "ep9_bug1", "ep10_bug2")
     rows, runs, output = _series_grades(tmp_path, True, ("kim", "lee"), tasks)
     scores = {s: [float(rows[s][t]) for t in tasks] for s in rows}
-    assert scores["kim"] == [15.0, 15.0, 15.0, 20.0], rows["kim"]
-    assert scores["lee"] == [15.0, 15.0, 15.0, 20.0], rows["lee"]
+    assert scores["kim"] == [15.0, 15.0, 15.0, 15.0, 20.0], rows["kim"]
+    assert scores["lee"] == [15.0, 15.0, 0.0, 15.0, 20.0], rows["lee"]
+    assert runs["lee", "ep8_bug0"]["reason"].endswith(
+        "package 'motion_plan' (lee/motion_plan) has no launch file 'bug0.launch'")
     assert runs["kim", "ep6_go_to_point"]["after_start"] == [
         "called /go_to_point_switch (data: true): success: True, message: Done!"]
+    # bug 0 went round the pillar (radius 1 m at (3.5, 0)), not through it
+    assert min(x for _, x, _ in runs["kim", "ep8_bug0"]["path"]) < 2.5
     left_out = {
         "ep9_bug1": [('<include file="$(find gazebo_ros)/launch/empty_world.launch">',
                       "it starts a simulator or a world"),
@@ -292,12 +306,13 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     assert "Turning: <b>legacy_mode true" in (output / "index.html").read_text()
 
     # (lee is graded once: her runs are kim's to the bit, shown above)
-    tasks = ("ep6_go_to_point", "ep7_follow_wall", "ep10_bug2")
     rows, runs, output = _series_grades(tmp_path, False, ("kim", "noa"), tasks)
     scores = {s: [float(rows[s][t]) for t in tasks] for s in rows}
-    assert scores["noa"] == [15.0, 15.0, 20.0], rows["noa"]
-    assert scores["kim"][0] == 0.0 and scores["kim"][2] == 0.0, rows["kim"]
-    for task, goal in (("ep6_go_to_point", "(2.00, 8.00)"), ("ep10_bug2", "(3.50, 3.50)")):
+    assert scores["noa"] == [15.0, 15.0, 15.0, 15.0, 20.0], rows["noa"]
+    turned_away = {"ep6_go_to_point": "(2.00, 8.00)", "ep8_bug0": "(3.50, 3.50)",
+                   "ep9_bug1": "(3.50, 3.50)", "ep10_bug2": "(3.50, 3.50)"}
+    for task, goal in turned_away.items():
+        assert float(rows["kim"][task]) == 0.0, (task, rows["kim"])
         reason = runs["kim", task]["reason"]
         assert reason.startswith("did not reach the goal %s within 0.30 m: turned away from "
                                  "the goal" % goal), reason
@@ -305,7 +320,7 @@ def test_the_series_final_packages_are_graded_with_the_turning_they_were_written
     index = (output / "index.html").read_text()
     assert "Turning: <b>legacy_mode false" in index
     # one short line per failed task in the table, the whole reason in its tooltip
-    for task in ("ep6_go_to_point", "ep10_bug2"):
+    for task in turned_away:
         assert '%s</a>: did not reach the goal: turned away from the goal</div>' % task \
             in index, task
     assert 'title="did not reach the goal (2.00, 8.00) within 0.30 m: turned away' in index
