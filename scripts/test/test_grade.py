@@ -58,16 +58,18 @@ def test_the_default_spec_covers_episodes_5_to_10():
     assert all("set_model_state_to_start" in t.allow for t in spec.tasks if "bug" in t.name)
 
 
-def test_the_benchmark_class_bug2_launch_takes_the_default_specs_start_and_goal(tmp_path):
-    """The grader's benchmark class hands in a bug2.launch: the default spec's ep10 command
-    starts it with initial_x/initial_y and des_x/des_y, and its params are those (roslaunch
-    refuses an argument the file does not declare)."""
+@pytest.mark.parametrize("task_name", ["ep8_bug0", "ep9_bug1", "ep10_bug2"])
+def test_the_benchmark_class_bug_launch_files_take_the_default_specs_start_and_goal(
+        tmp_path, task_name):
+    """The grader's benchmark class hands in bug 0-2's launch files: the default spec's
+    command line starts each (roslaunch refuses an argument the file does not declare), and
+    the parameters it sets are the task's start and goal."""
     from m2wr_tools.bench import grade as grade_bench
-    task, = [t for t in load(DEFAULT_SPEC).tasks if t.name == "ep10_bug2"]
+    task, = [t for t in load(DEFAULT_SPEC).tasks if t.name == task_name]
     words = list(task.command)
-    assert words[:3] == ["roslaunch", "motion_plan", "bug2.launch"]
-    launch = tmp_path / "bug2.launch"
-    launch.write_text(grade_bench.BUG2_LAUNCH)
+    assert words[:2] == ["roslaunch", "motion_plan"]
+    student, = grade_bench.make_class(str(tmp_path / "class"), 1)
+    launch = tmp_path / "class" / student / "motion_plan" / "launch" / words[2]
     dumped = subprocess.run(["roslaunch", "--dump-params", str(launch)] + words[3:],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             timeout=60, stdin=subprocess.DEVNULL)

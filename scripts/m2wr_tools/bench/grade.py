@@ -2,11 +2,14 @@
 its wall time and runs per minute, and the grader's own overhead per run beside the batch
 runner's on the same controller.
 
-The class is made here: each student a `motion_plan` package as the series lays it out,
-written from the project's programs (the tutorial's obstacle_avoidance.py, and the series-style
-go to point, wall follower and bug 2 of catkin_ws/src/motion_plan/test/series_style/ under the
-series' file names, with a bug2.launch). Like most classes, it hands in no bug 0 or bug 1:
-those two tasks fail at once ("no launch file"), as they would for a real student.
+The class is made here: each student a copy of the series' final `motion_plan` as a learner
+on Noetic hands it in (the grader's fixture scripts/test/fixtures/series_class/noa: the
+behaviours start switched off, go to point spins while off, bug 0-2 switch them and place
+m2wr, the turning signs flipped for the default spec's convention; the tutorial's
+obstacle_avoidance.py beside them), so every task of the default spec is handed in and its
+runs end where the series' do (bug 0-2 at their goals). Per task it prints the runs, the sim
+seconds a wall second of one worker while the world stepped (the sim stage) and over whole
+runs (start, stop, measure and replay included).
 
 Overhead [s wall] is a run's wall time less the part in which the world ran (the record's
 overhead_s, see m2wr_tools.batch.rig: resetting the world, starting and stopping the controller,
@@ -38,15 +41,10 @@ import time
 from ..paths import ROOT
 from .. import usage
 
-SERIES_STYLE = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "test", "series_style")
+SERIES_PACKAGE = os.path.join(ROOT, "scripts", "test", "fixtures", "series_class", "noa",
+                              "motion_plan")
 TUTORIAL = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "scripts",
                         "obstacle_avoidance.py")
-SCRIPTS = {                      # the student's file name: where its text comes from
-    "obstacle_avoidance.py": TUTORIAL,
-    "go_to_point.py": os.path.join(SERIES_STYLE, "series_style_go_to_point.py"),
-    "follow_wall.py": os.path.join(SERIES_STYLE, "series_style_follow_wall.py"),
-    "bug2.py": os.path.join(SERIES_STYLE, "series_style_bug2.py"),
-}
 PACKAGE_XML = """<?xml version="1.0"?>
 <package format="2">
   <name>motion_plan</name>
@@ -56,26 +54,10 @@ PACKAGE_XML = """<?xml version="1.0"?>
   <license>BSD</license>
   <buildtool_depend>catkin</buildtool_depend>
   <exec_depend>rospy</exec_depend>
+  <exec_depend>std_srvs</exec_depend>
+  <exec_depend>gazebo_msgs</exec_depend>
+  <exec_depend>tf</exec_depend>
 </package>
-"""
-BUG2_LAUNCH = """<?xml version="1.0"?>
-<launch>
-  <arg name="initial_x" default="0"/>
-  <arg name="initial_y" default="8"/>
-  <arg name="des_x" default="0"/>
-  <arg name="des_y" default="-4"/>
-  <param name="initial_x" value="$(arg initial_x)"/>
-  <param name="initial_y" value="$(arg initial_y)"/>
-  <param name="des_pos_x" value="$(arg des_x)"/>
-  <param name="des_pos_y" value="$(arg des_y)"/>
-  <node pkg="motion_plan" type="go_to_point.py" name="go_to_point" output="screen">
-    <param name="turn_sign" value="-1"/>
-  </node>
-  <node pkg="motion_plan" type="follow_wall.py" name="follow_wall" output="screen">
-    <param name="turn_sign" value="-1"/>
-  </node>
-  <node pkg="motion_plan" type="bug2.py" name="bug2" output="screen"/>
-</launch>
 """
 COMPARED_TASK = "ep5_avoid"      # the default spec's obstacle avoider ...
 DURATION = 60.0                  # [s sim] ... and its duration
@@ -98,26 +80,31 @@ def make_class(folder, students):
     names = ["student%02d" % (i + 1) for i in range(students)]
     for name in names:
         package = os.path.join(folder, name, "motion_plan")
-        os.makedirs(os.path.join(package, "scripts"))
-        os.makedirs(os.path.join(package, "launch"))
+        shutil.copytree(SERIES_PACKAGE, package)          # the fixture's links followed
         with open(os.path.join(package, "package.xml"), "w") as out:
             out.write(PACKAGE_XML.format(student=name))
-        for script, source in SCRIPTS.items():
-            with open(source) as text:
-                body = text.read()
-            # a Gazebo Noetic user's copy: m2wr turns the other way there, so the series'
-            # learners negate angular.z (the simulator's default, as the grader runs it)
-            body = body.replace('get_param("~turn_sign", 1)', 'get_param("~turn_sign", -1)')
-            # the behaviours stay switched off at start, as the series' final versions: the
-            # default spec switches them on for episodes 6 and 7 (after_start), bug 2 itself
-            path = os.path.join(package, "scripts", script)
-            with open(path, "w") as out:
-                out.write(body)
-            os.chmod(path, 0o755)
-        with open(os.path.join(package, "launch", "bug2.launch"), "w") as out:
-            out.write(BUG2_LAUNCH)
     os.chmod(folder, 0o700)
     return names
+
+
+def per_task(records):
+    """{task: figures} of the runs that ran the world: how many and how many passed, sim
+    seconds, and sim seconds a wall second of one worker while the world stepped and over
+    whole runs."""
+    tasks = {}
+    for r in records:
+        if r.get("stages") and r.get("sim_time_s"):
+            tasks.setdefault(r["task"], []).append(r)
+    figures = {}
+    for task, runs in sorted(tasks.items()):
+        sim = sum(r["sim_time_s"] for r in runs)
+        stepping = sum(r["stages"]["sim_s"] for r in runs)
+        wall = sum(r["wall_time_s"] for r in runs)
+        figures[task] = {"runs": len(runs), "passed": sum(1 for r in runs if r.get("success")),
+                         "sim_s": round(sim, 1),
+                         "x_real_time_stepping": round(sim / stepping, 1) if stepping else None,
+                         "x_real_time_whole_runs": round(sim / wall, 1) if wall else None}
+    return figures
 
 
 def _run(argv, what):
@@ -206,7 +193,7 @@ def bench(args):
         "grader_stages_ep5": _stage_medians(ep5),
         "batch_stages": _stage_medians(batch),
         "date": time.strftime("%Y-%m-%d %H:%M"), "load": os.getloadavg()[0],
-        "cores": os.cpu_count(), "rounds": rounds,
+        "cores": os.cpu_count(), "rounds": rounds, "tasks": per_task(records),
     }
     ratio = None
     if figures["grader_overhead_s_median_ep5"] and figures["batch_overhead_s_median"]:
@@ -217,6 +204,11 @@ def bench(args):
     print("[bench_grade] %(students)d students, %(runs)d runs (%(graded_runs)d ran the world) "
           "in %(wall_s).0f s with %(workers)s workers: %(runs_per_minute).1f runs a minute"
           % dict(figures, workers=args.workers or os.cpu_count()))
+    for task, f in figures["tasks"].items():
+        print("[bench_grade]   %-16s %3d runs, %3d passed, %6.0f s of sim: x real time a worker "
+              "%5.1f while stepping, %5.1f over whole runs"
+              % (task, f["runs"], f["passed"], f["sim_s"], f["x_real_time_stepping"] or 0.0,
+                 f["x_real_time_whole_runs"] or 0.0))
     print("[bench_grade] overhead a run [s wall, median of all rounds]: %s in the whole class; "
           "on the obstacle avoider alone grader %s (of which its own files, last look and end "
           "%s), batch runner %s: ratio %s (target <= 1.10)"
