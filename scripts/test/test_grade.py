@@ -279,6 +279,30 @@ def test_runs_that_cannot_start_fail_with_their_reason_and_the_rest_are_planned(
     assert reasons[("bob", "goal", 0)].startswith("no package.xml and no scripts")
 
 
+def test_runs_are_planned_world_by_world_so_that_a_worker_keeps_its_simulator(tmp_path):
+    """A worker relaunches its simulator when the world or the turning convention changes:
+    the runs go world by world in the spec's order, each world's students in name order."""
+    from m2wr_tools.grade.grading import plan
+    spec = load(_spec(tmp_path, """\
+        version: 1
+        tasks:
+          - {name: a, command: rosrun motion_plan go_to_point.py, kind: wander, world: world02}
+          - {name: b, command: rosrun motion_plan go_to_point.py, kind: wander, world: world03}
+          - {name: c, command: rosrun motion_plan go_to_point.py, kind: wander, world: world02}
+          - {name: d, command: rosrun motion_plan go_to_point.py, kind: wander, world: world02,
+             legacy_mode: true}
+        """))
+    class_dir = tmp_path / "class"
+    for student in ("bo", "ann"):
+        _package(str(class_dir / student / "motion_plan"))
+    todo, failed, _ = plan(spec, classroom.discover(str(class_dir)), str(tmp_path / "o"))
+    assert failed == []
+    assert [(s.task_name, s.student) for s in todo] == [
+        ("a", "ann"), ("c", "ann"), ("a", "bo"), ("c", "bo"),      # world02
+        ("b", "ann"), ("b", "bo"),                                 # world03
+        ("d", "ann"), ("d", "bo")]                                 # world02, legacy_mode
+
+
 def test_a_project_closed_to_other_users_is_named():
     """Runs start as unprivileged users: a project under a private folder (mktemp -d, a home
     folder) would hide m2wr_description and the project's Python from them."""

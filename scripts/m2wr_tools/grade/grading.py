@@ -88,6 +88,14 @@ def plan(spec, submissions, output):
                     todo.append(scenario)
                 else:
                     failed.append(_record(scenario, problem))
+    # The cluster hands runs out in this order. A worker keeps its simulator for the next run
+    # in the same world (and turning convention, a world launch argument) and relaunches it
+    # when they change: student by student that would be at every world the spec names, so
+    # the runs go world by world, in the spec's order, each world's students by name.
+    worlds = {}
+    for scenario in todo:
+        worlds.setdefault((scenario.world, scenario.legacy_mode), len(worlds))
+    todo.sort(key=lambda scenario: worlds[scenario.world, scenario.legacy_mode])
     return todo, failed, tuple(sorted(shadowed))
 
 
