@@ -169,6 +169,17 @@ defaults:
   legacy_mode: {legacy_mode}
 tasks:
 """
+BUG_TASK = """\
+  - name: {name}
+    command: roslaunch motion_plan {launch} initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
+    kind: goal
+    world: {{pillar}}
+    starts: [[3.5, -3.5, 0]]
+    goal: [3.5, 3.5]
+    duration: {duration}
+    points: {points}
+    allow: [set_model_state_to_start]
+"""                              # bug 0-2's tasks: alike but for these four fields
 SERIES_TASKS = {                 # each graded with the spec above: its text in the spec's list
     "ep6_go_to_point": """\
   - name: ep6_go_to_point
@@ -194,39 +205,10 @@ SERIES_TASKS = {                 # each graded with the spec above: its text in 
         request: "data: true"
         if_offered: true
 """,
-    "ep8_bug0": """\
-  - name: ep8_bug0
-    command: roslaunch motion_plan bug0.launch initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
-    kind: goal
-    world: {pillar}
-    starts: [[3.5, -3.5, 0]]
-    goal: [3.5, 3.5]
-    duration: 60
-    points: 15
-    allow: [set_model_state_to_start]
-""",
-    "ep9_bug1": """\
-  - name: ep9_bug1
-    command: roslaunch motion_plan bug1.launch initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
-    kind: goal
-    world: {pillar}
-    starts: [[3.5, -3.5, 0]]
-    goal: [3.5, 3.5]
-    duration: 90
-    points: 15
-    allow: [set_model_state_to_start]
-""",
-    "ep10_bug2": """\
-  - name: ep10_bug2
-    command: roslaunch motion_plan bug2.launch initial_x:=3.5 initial_y:=-3.5 des_x:=3.5 des_y:=3.5
-    kind: goal
-    world: {pillar}
-    starts: [[3.5, -3.5, 0]]
-    goal: [3.5, 3.5]
-    duration: 60
-    points: 20
-    allow: [set_model_state_to_start]
-""",
+    "ep8_bug0": BUG_TASK.format(name="ep8_bug0", launch="bug0.launch", duration=60, points=15),
+    "ep9_bug1": BUG_TASK.format(name="ep9_bug1", launch="bug1.launch", duration=90, points=15),
+    "ep10_bug2": BUG_TASK.format(name="ep10_bug2", launch="bug2.launch", duration=60,
+                                 points=20),
 }
 PILLAR = os.path.join(ROOT, "catkin_ws", "src", "motion_plan", "test", "worlds",
                       "pillar_on_the_line.world")
