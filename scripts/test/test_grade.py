@@ -279,9 +279,9 @@ def test_runs_that_cannot_start_fail_with_their_reason_and_the_rest_are_planned(
     assert reasons[("bob", "goal", 0)].startswith("no package.xml and no scripts")
 
 
-def test_runs_are_planned_world_by_world_so_that_a_worker_keeps_its_simulator(tmp_path):
-    """A worker relaunches its simulator when the world or the turning convention changes:
-    the runs go world by world in the spec's order, each world's students in name order."""
+def test_runs_are_planned_simulator_by_simulator_so_that_a_worker_keeps_its_own(tmp_path):
+    """A worker relaunches its simulator when the world, the seed or the turning convention
+    changes: the runs go by those, in the spec's order, each group's students in name order."""
     from m2wr_tools.grade.grading import plan
     spec = load(_spec(tmp_path, """\
         version: 1
@@ -291,16 +291,19 @@ def test_runs_are_planned_world_by_world_so_that_a_worker_keeps_its_simulator(tm
           - {name: c, command: rosrun motion_plan go_to_point.py, kind: wander, world: world02}
           - {name: d, command: rosrun motion_plan go_to_point.py, kind: wander, world: world02,
              legacy_mode: true}
+          - {name: e, command: rosrun motion_plan go_to_point.py, kind: wander, world: world03,
+             seeds: [0, 1]}
         """))
     class_dir = tmp_path / "class"
     for student in ("bo", "ann"):
         _package(str(class_dir / student / "motion_plan"))
     todo, failed, _ = plan(spec, classroom.discover(str(class_dir)), str(tmp_path / "o"))
     assert failed == []
-    assert [(s.task_name, s.student) for s in todo] == [
-        ("a", "ann"), ("c", "ann"), ("a", "bo"), ("c", "bo"),      # world02
-        ("b", "ann"), ("b", "bo"),                                 # world03
-        ("d", "ann"), ("d", "bo")]                                 # world02, legacy_mode
+    assert [(s.task_name, s.seed, s.student) for s in todo] == [
+        ("a", 0, "ann"), ("c", 0, "ann"), ("a", 0, "bo"), ("c", 0, "bo"),    # world02
+        ("b", 0, "ann"), ("e", 0, "ann"), ("b", 0, "bo"), ("e", 0, "bo"),    # world03
+        ("d", 0, "ann"), ("d", 0, "bo"),                                     # legacy_mode
+        ("e", 1, "ann"), ("e", 1, "bo")]                                     # world03, seed 1
 
 
 def test_a_project_closed_to_other_users_is_named():

@@ -104,7 +104,7 @@ class RunFailed(Exception):
 class Rig:
     def __init__(self):
         self.session = None
-        self.key = None               # (world, seed, lockstep, clock_hz, world args) now running
+        self.key = None               # (lockstep, clock_hz, simulator_key) now running
         self.simulator_pid = None
         self.recorder = None
         self.commands = 0
@@ -168,10 +168,17 @@ class Rig:
                     for c in connections if c[0] in ours]
         return commands, (contacts[0] if len(contacts) == 1 else None)
 
+    @classmethod
+    def simulator_key(cls, scenario):
+        """What of `scenario` decides the simulator its run needs: a worker keeps its running
+        simulator for a next run of the same key (and the same batch options) and relaunches
+        it for another, so a batch handed out in key order relaunches least."""
+        return (scenario.world, scenario.seed) + tuple(cls._world_args(scenario))
+
     def _ensure_simulator(self, scenario, options):
         """True when the running simulator is reused; else (re)launches it."""
         extra = tuple(self._world_args(scenario))
-        key = (scenario.world, scenario.seed, options.lockstep, options.clock_hz, extra)
+        key = (options.lockstep, options.clock_hz) + self.simulator_key(scenario)
         world = self.session.child("world")
         if options.reuse and self.key == key and world is not None and world.running():
             return True
@@ -189,7 +196,8 @@ class Rig:
         self.key = key
         return False
 
-    def _world_args(self, scenario):
+    @classmethod
+    def _world_args(cls, scenario):
         """Further `name:=value` arguments of the world launch for `scenario` (a tool built
         on the batch runner adds its own, e.g. the grader's legacy_mode); part of the key
         that decides whether the running simulator is kept."""

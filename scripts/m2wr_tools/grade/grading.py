@@ -18,7 +18,7 @@ from ..batch.cluster import run_batch
 from ..running.commands import check
 from ..analysis.metrics import Task
 from . import classroom, sandbox
-from .runner import GradedScenario, GradeOptions, grade_run
+from .runner import GradedScenario, GradeOptions, GradeRig, grade_run
 from ..paths import ROOT
 
 
@@ -89,13 +89,13 @@ def plan(spec, submissions, output):
                 else:
                     failed.append(_record(scenario, problem))
     # The cluster hands runs out in this order. A worker keeps its simulator for the next run
-    # in the same world (and turning convention, a world launch argument) and relaunches it
-    # when they change: student by student that would be at every world the spec names, so
-    # the runs go world by world, in the spec's order, each world's students by name.
-    worlds = {}
+    # of the same world, seed and turning convention (the rig's simulator_key) and relaunches
+    # it when they change: student by student that would be at nearly every run, so the runs
+    # go simulator by simulator, in the spec's order, each one's students by name.
+    simulators = {}
     for scenario in todo:
-        worlds.setdefault((scenario.world, scenario.legacy_mode), len(worlds))
-    todo.sort(key=lambda scenario: worlds[scenario.world, scenario.legacy_mode])
+        simulators.setdefault(GradeRig.simulator_key(scenario), len(simulators))
+    todo.sort(key=lambda scenario: simulators[GradeRig.simulator_key(scenario)])
     return todo, failed, tuple(sorted(shadowed))
 
 

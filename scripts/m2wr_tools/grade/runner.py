@@ -109,7 +109,8 @@ class GradeRig(Rig):
     def _call_log(self):
         return os.path.join(self.session.log_dir, gazebo_calls.FILE_NAME)
 
-    def _world_args(self, scenario):
+    @classmethod
+    def _world_args(cls, scenario):
         return ("legacy_mode:=%s" % str(bool(getattr(scenario, "legacy_mode", False))).lower(),)
 
     def _ensure_simulator(self, scenario, options):
