@@ -13,7 +13,10 @@ and what they share, one sub-package a job. Index:
     session         one ROS session: own master on a free port, simulator, spawn, controller,
                     rosbag, all stopped by PID
     zygote          a warm process that forks Python controllers with rospy already imported
-    warm_rospy      rospy's idle waits shortened in the zygote's children
+    warm_rospy      rospy's idle waits shortened in the zygote's children, their own
+                    remappings and namespace
+    warm_launch     roslaunch PKG FILE in a zygote child: the file read as roslaunch reads it,
+                    its Python nodes forked
     stale_nodes     nodes the master still lists after they ended, and forgetting them
     param_snapshot  the parameter server as a run found it, put back after the run
     commands        a controller's command line checked before any run starts

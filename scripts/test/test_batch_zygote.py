@@ -161,3 +161,17 @@ def test_a_graded_child_starts_with_its_folder_limits_and_user(warm):
             assert "ids 65534 65534 65534 []" in out and "no way back" in out
     finally:
         shutil.rmtree(folder)
+
+
+def test_roslaunch_command_lines_a_warm_launch_takes():
+    """roslaunch's own command line, package and file or a file, with name:=value arguments
+    and --screen; its other options (another master, --wait, --nodes ...) run as roslaunch."""
+    from m2wr_tools.running import warm_launch
+    assert warm_launch.accepts(["roslaunch", "motion_plan", "bug2.launch", "des_x:=1"])
+    assert warm_launch.accepts(["roslaunch", "--screen", "/w/bug2.launch"])
+    assert warm_launch.accepts(["/opt/ros/bin/roslaunch", "motion_plan", "bug2.launch"])
+    assert not warm_launch.accepts(["roslaunch", "-p", "11312", "motion_plan", "bug2.launch"])
+    assert not warm_launch.accepts(["roslaunch", "--wait", "motion_plan", "bug2.launch"])
+    assert not warm_launch.accepts(["roslaunch"])
+    assert not warm_launch.accepts(["roslaunch", "a", "b", "c"])
+    assert not warm_launch.accepts(["rosrun", "motion_plan", "bug2.py"])

@@ -9,8 +9,9 @@ depends only on its scenario:
   generator re-seeded, the drive's command and lockstep's awaited answer forgotten) ->
   /gazebo/set_model_state m2wr at the start (z 0.5 m, at rest, as spawn.launch drops it) ->
   the recorder restarted (one per rig: its connections stay up) -> the controller started
-  (a Python script is forked from the session's warm zygote, m2wr_tools.running.zygote; anything
-  else is a plain process) and publishing cmd_vel -> if a command already reached the
+  (a Python script is forked from the session's warm zygote, m2wr_tools.running.zygote, and
+  so is `roslaunch PKG FILE ARGS`, whose Python nodes are forked in turn,
+  m2wr_tools.running.warm_launch; anything else is a plain process) and publishing cmd_vel -> if a command already reached the
   simulator, /gazebo/reset_world and m2wr put back where it stood (the drive forgets a
   command sent as the controller started, which reached it or not as the connection came
   up: every run starts alike) -> physics unpaused for `duration` s of sim time -> paused ->
@@ -456,8 +457,8 @@ class Rig:
 
     def _start_controller(self, argv, log_path, warm):
         """The run's controller as the session's child "controller": forked from the warm
-        zygote when it is a Python script of this interpreter (see m2wr_tools.running.zygote), else
-        a plain subprocess (roslaunch, binaries, other interpreters)."""
+        zygote when it is a Python script of this interpreter or a roslaunch command line
+        (see _start_warm_or_plain), else a plain subprocess (binaries, other interpreters)."""
         session = self.session
         return self._start_warm_or_plain(
             argv, log_path, warm, session.env, lambda: session.start_controller(
@@ -465,14 +466,18 @@ class Rig:
 
     def _start_warm_or_plain(self, argv, log_path, warm, env, plain, **confine):
         """The session's child "controller": forked from the worker's zygote when `warm` and
-        `argv` is a Python script of this interpreter, with `confine` (zygote.Zygote.start's
-        cwd, user, group, rlimits) set in the child before the script's first line; else,
-        or when the zygote fails (a new one comes next run), `plain()`'s child."""
-        from ..running import zygote
+        `argv` is a Python script of this interpreter or a roslaunch command line that
+        running.warm_launch takes (its Python nodes forked in turn), with `confine`
+        (zygote.Zygote.start's cwd, user, group, rlimits) set in the child before the
+        script's first line; else, or when the zygote fails (a new one comes next run),
+        `plain()`'s child."""
+        from ..running import warm_launch, zygote
         child = None
-        if warm and zygote.warm_script(argv, env.get("PATH", os.defpath)):
+        launch = warm_launch.accepts(argv)
+        if warm and (launch or zygote.warm_script(argv, env.get("PATH", os.defpath))):
             try:
-                child = self._zygote().start("controller", argv, env, log_path, **confine)
+                child = self._zygote().start("controller", argv, env, log_path, launch=launch,
+                                             **confine)
             except RuntimeError:
                 self.zygote.close()
                 self.zygote = None

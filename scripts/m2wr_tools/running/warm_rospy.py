@@ -19,6 +19,9 @@ busy thread at exit, are shortened:
   wind down before the interpreter's teardown, which a zygote child never does (it leaves
   with os._exit once the program has returned): skipped.
 
+A child also takes its own command line's remappings and namespace (`take_command_line`):
+rospy reads them as it is imported, in the zygote.
+
 `on_spin` is called once, when the program first enters rospy.spin(): its node has made
 every subscription and publisher of its main thread (the batch runner then only waits for
 the simulator's connections, not for the program to look idle).
@@ -82,3 +85,18 @@ def quicken(on_spin=lambda: None):
 
     from pybullet_gazebo.ros import quick_exit
     quick_exit.install()
+
+
+def take_command_line():
+    """rospy reads the node's remappings (`from:=to`, `__name:=`, `__ns:=`, `_param:=`) from
+    sys.argv, and its namespace (ROS_NAMESPACE or `__ns:=`), once, as it is imported: in the
+    zygote, whose command line and environment are not the program's. A child takes its own
+    here (sys.argv and os.environ set), before its program runs, as a fresh interpreter would
+    have read them: a launch file's `<remap>`, its node's name and `ns`, or rosrun's
+    `scan:=/other`."""
+    import rosgraph.names
+    import rospy.names
+    rospy.names.reload_mappings(sys.argv)
+    namespace = rosgraph.names.get_ros_namespace()
+    rospy.names._caller_namespace = namespace
+    rospy.names._caller_id = namespace + "unnamed"

@@ -52,3 +52,25 @@ def test_a_warm_rospy_program_says_when_it_spins_and_stops_at_once_on_sigint(mas
         assert not child.spinning()
     finally:
         z.close()
+
+
+def test_a_warm_program_takes_its_own_remappings_name_and_namespace(master, tmp_path):
+    """rospy reads them as it is imported (in the zygote): `rosrun PKG SCRIPT __name:=...
+    chatter:=...` and ROS_NAMESPACE must still reach the program, as in a fresh interpreter."""
+    script = tmp_path / "program.py"
+    script.write_text(PROGRAM.replace('rospy.Subscriber("/chatter"', 'rospy.Subscriber("chatter"'))
+    script.chmod(0o755)
+    z = zygote.Zygote(master, str(tmp_path / "zygote.log"))
+    try:
+        log = str(tmp_path / "program.log")
+        env = dict(master, ROS_NAMESPACE="/team")
+        child = z.start("controller", [str(script), "__name:=renamed", "chatter:=heard"], env,
+                        log)
+        assert child.spinning(timeout=30.0), processes.log_tail(log)
+        import xmlrpc.client
+        state = xmlrpc.client.ServerProxy(master["ROS_MASTER_URI"]).getSystemState("/t")[2]
+        assert ["/team/heard", ["/team/renamed"]] in state[1], state
+        child.signal_group(signal.SIGINT)
+        assert child.wait(10.0) == 0
+    finally:
+        z.close()
