@@ -33,8 +33,9 @@ with reuse; prints the resident memory of the worker, its simulator and its cont
 zygote at runs 1, 50, 100, 150, 200 and the slope [MiB per 100 runs] after run 20.
 
 Python controllers are forked from a warm process (m2wr_tools.running.zygote: rospy already
-imported; the script itself still starts afresh each run); --cold-start starts them as
-plain processes.
+imported; the script itself still starts afresh each run), and so are `roslaunch PKG FILE`
+controllers, whose Python nodes are forked in turn (m2wr_tools.running.warm_launch);
+--cold-start starts them as plain processes.
 
 Exit status: 0 when the batch finished (failed runs included); 1 when it could not run;
 2 for bad arguments; 130 when interrupted.
@@ -122,8 +123,8 @@ def parse_args(argv):
     parser.add_argument("--bench-runs", type=int, default=None,
                         help="runs of the benchmark (default: 20; 200 with --bench-memory)")
     parser.add_argument("--cold-start", action="store_true",
-                        help="start Python controllers as plain processes, not from the "
-                        "warm zygote")
+                        help="start Python controllers and roslaunch as plain processes, "
+                        "not from the warm zygote")
     args = parser.parse_args(argv)
     if args.duration is None:
         args.duration = 5.0 if args.bench_memory else 60.0

@@ -45,8 +45,9 @@ def parse_args(argv):
     parser.add_argument("--fresh", action="store_true", help="grade again from scratch")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--cold-start", action="store_true",
-                        help="start Python controllers as new interpreters through prlimit, "
-                             "not forked from a warm one (same limits and user either way)")
+                        help="start Python controllers and roslaunch as new interpreters "
+                             "through prlimit, not forked from a warm one (same limits and "
+                             "user either way)")
     parser.add_argument("--replay", nargs=3, metavar=("STUDENT", "TASK", "RUN"),
                         help="run one graded run again, on this machine, and draw it")
     parser.add_argument("--gui", action="store_true", help="with --replay: show the simulator's window, at real time")
