@@ -243,12 +243,9 @@ def report(args, records, outlines_of, scenarios):
         say("picture %s" % path)
     replays = [r for r in records if r.get("replay") and os.path.isfile(r["replay"])]
     if replays:
-        import json
         from pybullet_gazebo.web import site
         for r in replays:
-            with open(r["replay"]) as source:
-                site.write_replay(os.path.join(args.output, "runs"), r["run_id"],
-                                  json.load(source))
+            site.write_replay_file(os.path.join(args.output, "runs"), r["run_id"], r["replay"])
         say("replays: %d pages %s" % (len(replays), os.path.join(args.output, "runs", "*.html")))
     say("results %s and results.csv" % os.path.join(args.output, "results.json"))
 

@@ -4,7 +4,6 @@ writes it as runs/<run_id>.html + .js beside runs/web/ (the page's files and thr
 the report stays a folder that opens from disk with no network, and each student page
 embeds its runs' replays next to their pictures."""
 import html
-import json
 import os
 
 from pybullet_gazebo.web import site
@@ -19,9 +18,7 @@ def write_replays(output, records):
         path = record.get("replay")
         if not path or not os.path.isfile(path):
             continue
-        with open(path) as source:
-            replay = json.load(source)
-        site.write_replay(os.path.join(output, "runs"), record["run_id"], replay)
+        site.write_replay_file(os.path.join(output, "runs"), record["run_id"], path)
         pages[record["run_id"]] = record["run_id"] + ".html"
     return pages
 

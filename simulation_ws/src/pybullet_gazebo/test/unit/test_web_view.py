@@ -264,6 +264,26 @@ def test_a_replay_folder_holds_everything_its_page_needs(tmp_path):
     assert "http" not in text.replace("http-equiv", "")
 
 
+def test_a_kept_replay_file_makes_the_same_page_as_the_replay_itself(tmp_path):
+    """The report copies a run's kept replay JSON into its page unparsed: the same data file
+    and page as from the replay, the title read from the text (also when it is not first)."""
+    import json
+    replay = {"title": 'bug 2 "round" <the pillar>', "scene": {"models": [1, 2]},
+              "robots": {}, "frames": [{"t": 0.1, "hits": {}}]}
+    kept = tmp_path / "kept.replay.json"
+    kept.write_text(json.dumps(replay, separators=(",", ":")))
+    site.write_replay(str(tmp_path / "a"), "run", replay)
+    site.write_replay_file(str(tmp_path / "b"), "run", str(kept))
+    for name in ("run.js", "run.html"):
+        assert (tmp_path / "a" / name).read_text() == (tmp_path / "b" / name).read_text()
+    assert "<title>bug 2 &quot;round&quot; &lt;the pillar&gt;</title>" in \
+        (tmp_path / "b" / "run.html").read_text()
+    reordered = tmp_path / "reordered.replay.json"
+    reordered.write_text(json.dumps({"frames": [], "title": "late title"}))
+    page = site.write_replay_file(str(tmp_path / "c"), "run", str(reordered))
+    assert "<title>late title</title>" in open(page).read()
+
+
 def test_the_web_parameters_and_their_defaults():
     from pybullet_gazebo.ros.params import ParameterError, SimulatorParams
     d = SimulatorParams.from_values({})

@@ -71,15 +71,44 @@ def replay_page(data_file, title, assets=ASSETS):
 def write_replay(folder, name, replay):
     """Writes <folder>/<name>.js and <folder>/<name>.html (and the assets); returns the
     page's path."""
+    return _write_replay(folder, name, json.dumps(replay, separators=(",", ":")),
+                         replay.get("title", name))
+
+
+def write_replay_file(folder, name, path):
+    """write_replay for a replay kept as JSON in the file `path` (the batch runner's
+    runs/<run_id>.replay.json): its text goes into the page's data as it is, unparsed (a
+    class's report holds 180 of them, 1-4 MB each: parsed and written again, they took
+    the report 40 s)."""
+    with open(path, encoding="utf-8") as source:
+        text = source.read()
+    return _write_replay(folder, name, text, _title(text) or name)
+
+
+def _title(text):
+    """The replay's "title" from its JSON text: read from the text's start when the object
+    begins with it (as replays.build makes it), else from the whole object."""
+    head = '{"title":'
+    if text.startswith(head):
+        try:
+            title, _ = json.JSONDecoder().raw_decode(text, len(head))
+            if isinstance(title, str):
+                return title
+        except ValueError:
+            pass
+    return json.loads(text).get("title")
+
+
+def _write_replay(folder, name, data, title):
     write_assets(folder)
     data_file = name + ".js"
-    with open(os.path.join(folder, data_file), "w") as out:
+    with open(os.path.join(folder, data_file), "w", encoding="utf-8") as out:
         out.write("var M2WR_REPLAY = ")
-        json.dump(replay, out, separators=(",", ":"))
+        out.write(data)
         out.write(";\n")
     page = os.path.join(folder, name + ".html")
-    with open(page, "w") as out:
-        out.write(replay_page(data_file, replay.get("title", name)))
+    with open(page, "w", encoding="utf-8") as out:
+        out.write(replay_page(data_file, title))
     return page
 
 
