@@ -280,8 +280,8 @@ def test_a_kept_replay_file_makes_the_same_page_as_the_replay_itself(tmp_path):
         (tmp_path / "b" / "run.html").read_text()
     reordered = tmp_path / "reordered.replay.json"
     reordered.write_text(json.dumps({"frames": [], "title": "late title"}))
-    page = site.write_replay_file(str(tmp_path / "c"), "run", str(reordered))
-    assert "<title>late title</title>" in open(page).read()
+    site.write_replay_file(str(tmp_path / "c"), "run", str(reordered))
+    assert "<title>late title</title>" in (tmp_path / "c" / "run.html").read_text()
 
 
 def test_the_web_parameters_and_their_defaults():
