@@ -85,9 +85,14 @@ def launch_env(tmp_path):
 
 
 def _publishers(env, topic):
-    master = xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"])
-    _, _, (publishers, _, _) = master.getSystemState("/test")
+    with xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"]) as master:
+        _, _, (publishers, _, _) = master.getSystemState("/test")
     return [nodes for name, nodes in publishers if name == topic]
+
+
+def _read(path, mode="r"):
+    with open(path, mode) as source:
+        return source.read()
 
 
 def test_a_launch_file_runs_warm_as_roslaunch_would_run_it(launch_env):
@@ -107,12 +112,12 @@ def test_a_launch_file_runs_warm_as_roslaunch_would_run_it(launch_env):
         pids = [int(line.rsplit("[", 1)[1].rstrip("]")) for line in text.splitlines()
                 if line.startswith("process[")]
         assert len(pids) == 2, text
-        launcher_cmdline = open("/proc/%d/cmdline" % child.pid, "rb").read()
+        launcher_cmdline = _read("/proc/%d/cmdline" % child.pid, "rb")
         for pid in pids:
             # a fork of the launcher, which is a fork of the zygote: no interpreter started
-            assert open("/proc/%d/cmdline" % pid, "rb").read() == launcher_cmdline
+            assert _read("/proc/%d/cmdline" % pid, "rb") == launcher_cmdline
             assert os.getpgid(pid) == child.pid
-        wait_until(lambda: any("quitter in the log folder" in open(os.path.join(d, f)).read()
+        wait_until(lambda: any("quitter in the log folder" in _read(os.path.join(d, f))
                                for d, _, files in os.walk(tmp_path / "ros") for f in files
                                if f == "quitter-stdout.log"), 10.0, "quitter's output file")
         child.signal_group(signal.SIGINT)

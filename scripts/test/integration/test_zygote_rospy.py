@@ -68,7 +68,8 @@ def test_a_warm_program_takes_its_own_remappings_name_and_namespace(master, tmp_
                         log)
         assert child.spinning(timeout=30.0), processes.log_tail(log)
         import xmlrpc.client
-        state = xmlrpc.client.ServerProxy(master["ROS_MASTER_URI"]).getSystemState("/t")[2]
+        with xmlrpc.client.ServerProxy(master["ROS_MASTER_URI"]) as proxy:
+            state = proxy.getSystemState("/t")[2]
         assert ["/team/heard", ["/team/renamed"]] in state[1], state
         child.signal_group(signal.SIGINT)
         assert child.wait(10.0) == 0
