@@ -56,3 +56,57 @@ def test_the_registration_thread_ends_with_the_shutdown_only_when_woken_after_th
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=60)
     assert done.returncode == 0, done.stdout
     assert "thread alive after shutdown: %s" % alive in done.stdout, done.stdout
+
+
+SLEEPER = r"""
+import threading
+import time
+import rospy
+import rospy.core
+import rospy.rostime
+from rospy.impl.registration import RegManager
+from pybullet_gazebo.ros import quick_exit
+
+
+class WaitsUntilWoken(threading.Condition):
+    def wait(self, timeout=None):
+        return super().wait(None)
+
+
+class Handler:
+    done = False
+
+
+if WAKE:
+    quick_exit.install()
+RegManager(Handler())                       # as init_node makes it: adds the shutdown hook
+rospy.rostime._rostime_cond = WaitsUntilWoken()
+rospy.rostime.set_rostime_initialized(True)
+rospy.rostime._set_rostime(rospy.Time(1))   # /use_sim_time: the world paused at 1 s
+ended = []
+
+
+def loop():
+    try:
+        rospy.sleep(10.0)                   # a rospy.Rate loop's sleep, on sim time
+    except rospy.exceptions.ROSInterruptException:
+        ended.append(True)
+thread = threading.Thread(target=loop, daemon=True)
+thread.start()
+while not rospy.rostime._rostime_cond._waiters:
+    time.sleep(0.001)
+rospy.core.signal_shutdown("test")
+thread.join(2.0)
+print("sleeper ended with the shutdown:", bool(ended))
+"""
+
+
+@pytest.mark.parametrize("wake, ended", [(True, True), (False, False)])
+def test_a_sleep_on_sim_time_ends_with_the_shutdown_only_when_woken(wake, ended):
+    """rospy's sim-time sleep looks at the shutdown flag between 0.5 s waits on its time
+    condition; here that condition waits without end unless woken (outcome, not timing)."""
+    env = dict(os.environ, LOCKSTEP_HANDSHAKE="off")
+    done = subprocess.run([sys.executable, "-c", "WAKE = %r\n" % wake + SLEEPER], env=env,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=60)
+    assert done.returncode == 0, done.stdout
+    assert "sleeper ended with the shutdown: %s" % ended in done.stdout, done.stdout
