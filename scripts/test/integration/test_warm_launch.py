@@ -5,6 +5,7 @@ takes the node's own), its Python nodes are forks of the
 launcher (no interpreter of theirs started), output="screen" is in the run's log and the
 others' in the ROS log folder, a required node that ends stops the rest, and SIGINT to the
 group ends every node the way rospy ends it."""
+import contextlib
 import os
 import signal
 import xmlrpc.client
@@ -90,17 +91,29 @@ def _publishers(env, topic):
     return [nodes for name, nodes in publishers if name == topic]
 
 
+@contextlib.contextmanager
+def _launched(launch_env, *argv):
+    """(the launcher, its log) running `roslaunch ARGV` warm; every process of its group
+    ends with the test."""
+    warm, env, tmp_path = launch_env
+    log = str(tmp_path / "run.log")
+    child = warm.start("controller", ["roslaunch", *argv], env, log, launch=True)
+    try:
+        yield child, log
+    finally:
+        if child.running():
+            child.signal_group(signal.SIGKILL)
+        child.close()
+
+
 def _read(path, mode="r"):
     with open(path, mode) as source:
         return source.read()
 
 
 def test_a_launch_file_runs_warm_as_roslaunch_would_run_it(launch_env):
-    warm, env, tmp_path = launch_env
-    log = str(tmp_path / "run.log")
-    child = warm.start("controller", ["roslaunch", "wl_test", "two.launch", "greeting:=hey"],
-                       env, log, launch=True)
-    try:
+    _, env, tmp_path = launch_env
+    with _launched(launch_env, "wl_test", "two.launch", "greeting:=hey") as (child, log):
         wait_until(lambda: _publishers(env, "/said") == [["/robot/talker"]], 30.0,
                    "/robot/talker publishing /said (%s)" % processes.log_tail(log))
         wait_until(lambda: "talker /robot/talker" in processes.log_tail(log), 10.0,
@@ -126,34 +139,18 @@ def test_a_launch_file_runs_warm_as_roslaunch_would_run_it(launch_env):
         assert "talker ends" in text
         assert "[robot/talker] process has finished cleanly" in text, text
         assert not any(processes.alive(pid) for pid in pids)
-    finally:
-        child.signal_group(signal.SIGKILL)
-        child.close()
 
 
 def test_a_required_node_that_ends_stops_the_launch(launch_env):
-    warm, env, tmp_path = launch_env
-    log = str(tmp_path / "run.log")
-    child = warm.start("controller", ["roslaunch", "wl_test", "two.launch", "quit:=true"],
-                       env, log, launch=True)
-    try:
+    with _launched(launch_env, "wl_test", "two.launch", "quit:=true") as (child, log):
         assert child.wait(30.0) == 0, processes.log_tail(log, 40)
         text = processes.log_tail(log, 40)
         assert "[quitter] required node has ended: stopping the others" in text, text
         assert "talker ends" in text, text
-    finally:
-        child.signal_group(signal.SIGKILL)
-        child.close()
 
 
 def test_a_launch_file_that_cannot_be_read_ends_the_launch_with_roslaunch_s_reason(launch_env):
-    warm, env, tmp_path = launch_env
-    log = str(tmp_path / "run.log")
-    child = warm.start("controller", ["roslaunch", "wl_test", "missing.launch"], env, log,
-                       launch=True)
-    try:
+    with _launched(launch_env, "wl_test", "missing.launch") as (child, log):
         assert child.wait(30.0) == 1
         text = processes.log_tail(log)
         assert "RLException" in text and "missing.launch" in text, text
-    finally:
-        child.close()

@@ -13,7 +13,7 @@ import sys
 
 import pytest
 
-CASE = r"""
+PRELUDE = r"""
 import threading
 import time
 import rospy.core
@@ -29,6 +29,9 @@ class WaitsUntilWoken(threading.Condition):
 class Handler:
     done = False
 
+"""
+
+CASE = PRELUDE + r"""
 
 if WAKE:
     quick_exit.install()                    # before the node's RegManager is made
@@ -58,24 +61,9 @@ def test_the_registration_thread_ends_with_the_shutdown_only_when_woken_after_th
     assert "thread alive after shutdown: %s" % alive in done.stdout, done.stdout
 
 
-SLEEPER = r"""
-import threading
-import time
+SLEEPER = PRELUDE + r"""
 import rospy
-import rospy.core
 import rospy.rostime
-from rospy.impl.registration import RegManager
-from pybullet_gazebo.ros import quick_exit
-
-
-class WaitsUntilWoken(threading.Condition):
-    def wait(self, timeout=None):
-        return super().wait(None)
-
-
-class Handler:
-    done = False
-
 
 if WAKE:
     quick_exit.install()
