@@ -226,6 +226,11 @@ class Zygote:
         if self.process.wait(1.0) is None:       # the end of its input ends it
             processes.stop([self.process], sigint_timeout=0.0, sigterm_timeout=2.0)
         self.process.close()
+        # the listener's readline ends with the shutdown; the socket's file is closed after
+        # it (a socket closed while its file is open stays open until collected)
+        self._thread.join(2.0)
+        if not self._thread.is_alive():
+            self._reader.close()
         self._socket.close()
 
 

@@ -30,14 +30,18 @@ while not rospy.is_shutdown():
 print("talker ends", flush=True)
 """
 
+# (its line comes after its call to the master: rospy hangs for good when SIGINT comes while
+# a thread of the node is in a master call, as its shutdown calls the master through the same
+# locked proxy; roslaunch and warm_launch end such a node with SIGTERM after 15 s)
 QUITTER = """#!/usr/bin/env python3
 import time, rospy
 rospy.init_node("named_in_its_code")
+after = rospy.get_param("~after", None)
 print("quitter in the log folder", flush=True)
-if rospy.get_param("~after", None) is None:
+if after is None:
     rospy.spin()
 else:
-    time.sleep(rospy.get_param("~after"))
+    time.sleep(after)
 """
 
 LAUNCH = """<launch>
