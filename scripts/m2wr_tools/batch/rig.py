@@ -11,14 +11,14 @@ depends only on its scenario:
   the recorder restarted (one per rig: its connections stay up) -> the controller started
   (a Python script is forked from the session's warm zygote, m2wr_tools.running.zygote, and
   so is `roslaunch PKG FILE ARGS`, whose Python nodes are forked in turn,
-  m2wr_tools.running.warm_launch; anything else is a plain process) and publishing cmd_vel -> if a command already reached the
-  simulator, /gazebo/reset_world and m2wr put back where it stood (the drive forgets a
-  command sent as the controller started, which reached it or not as the connection came
-  up: every run starts alike) -> physics unpaused for `duration` s of sim time -> paused ->
-  the controller sent SIGINT while the run is measured (the record's controller_stop says
-  so; a zygote's rospy program ends ~0.1 s later, m2wr_tools.running.warm_rospy) -> its exit
-  awaited (the next run's reset comes after it: none of its commands can reach
-  that run).
+  m2wr_tools.running.warm_launch; anything else is a plain process) and publishing cmd_vel
+  -> if a command already reached the simulator, /gazebo/reset_world and m2wr put back
+  where it stood (the drive forgets a command sent as the controller started, which
+  reached it or not as the connection came up: every run starts alike) -> physics unpaused
+  for `duration` s of sim time -> paused -> the controller sent SIGINT while the run is
+  measured (the record's controller_stop says so; a zygote's rospy program ends ~0.1 s
+  later, m2wr_tools.running.warm_rospy) -> its exit awaited (the next run's reset comes
+  after it: none of its commands can reach that run).
 
 Per-run `stages` [s wall] in the record: reset_s, controller_start_s, sim_s, measure_s (of
 which replay_s made the run's replay, when asked for), stop_s; `overhead_s` = the run's wall

@@ -2,11 +2,11 @@
 and its nodes forked, in a child of the worker's zygote (m2wr_tools.running.zygote).
 
 A graded bug run's `roslaunch motion_plan bug2.launch` costs a cold roslaunch and three cold
-Python interpreters, each importing rospy and the message modules: 1.5-2 s of wall time a
-run on two busy cores, as much as the run's stepping. Forked from the zygote, rospy and the
-message modules are imported already (the launcher adds roslaunch's), and each Python node
-is a fork of the launcher with its script run as __main__ (zygote.run_script: the same start
-as a warm controller's).
+Python interpreters, each importing rospy and the message modules: on two busy cores, as
+much wall time as the run's stepping (docs/performance.md, "Grading a class"). Forked
+from the zygote, rospy and the message modules are imported already (the launcher adds
+roslaunch's), and each Python node is a fork of the launcher with its script run as
+__main__ (zygote.run_script: the same start as a warm controller's).
 
 What is roslaunch's and what is ours:
 - roslaunch's: reading the launch file (XmlLoader with the command line's `name:=value`
@@ -45,8 +45,8 @@ import xmlrpc.client
 
 SIGINT_TIMEOUT = 15.0      # [s] roslaunch's own (nodeprocess.DEFAULT_TIMEOUT_SIGINT)
 SIGTERM_TIMEOUT = 2.0      # [s] likewise
-OPTIONS = ("--screen",)    # roslaunch options a warm launch honours (every node's output is
-                           # on the launcher's already)
+OPTIONS = ("--screen",)    # roslaunch options a warm launch honours (--screen: every node's
+                           # output on the launcher's, as output="screen" puts it)
 
 
 def accepts(argv):
@@ -71,7 +71,7 @@ class _Node:
         self.argv = node_args.create_local_process_args(node, node.machine)
         self.env = core.setup_env(node, node.machine, master_uri)
         self.prefix = shlex.split(node.launch_prefix) if node.launch_prefix else []
-        self.label = "%s" % node.name if node.namespace in ("", "/") else \
+        self.label = node.name if node.namespace in ("", "/") else \
             "%s/%s" % (node.namespace.strip("/"), node.name)
         self.pid = None
         self.stdout = None if log_dir is None or node.output == "screen" else os.path.join(

@@ -51,8 +51,9 @@ from . import processes, warm_launch
 
 PRELOAD = ("rospy", "std_msgs.msg", "sensor_msgs.msg", "geometry_msgs.msg", "nav_msgs.msg",
            "tf2_msgs.msg", "gazebo_msgs.msg", "gazebo_msgs.srv", "std_srvs.srv", "numpy")
-# (roslaunch's modules are not among them: the launcher imports them, 0.16 s, rather than
-# every warm child's resident size growing by their 14 MiB, which the grader counts)
+# (roslaunch's modules are not among them: the launcher imports them itself, rather than
+# every warm child's resident size growing by theirs, which the grader reports as the
+# student's memory)
 
 
 def warm_script(argv, path_env):

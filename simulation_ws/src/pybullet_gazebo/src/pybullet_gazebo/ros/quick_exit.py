@@ -6,10 +6,11 @@ signal_shutdown then joins: every rospy node takes up to 0.5 s longer to exit th
 Likewise a thread in rospy.sleep or rospy.Rate.sleep on sim time (/use_sim_time) waits on
 rospy's time condition in 0.5 s waits and looks at the flag only between them: nothing
 wakes it at shutdown, so a loop program ended while the world is paused (the batch
-runner's and the grader's SIGINT at a run's end) exits up to 0.5 s late. The simulator and the tools start and stop many nodes (every run of the batch runner, the
-grader and the tests), so every node of the project's environment wakes that thread and the
-sim-time sleepers once more after the flag is up (lockstep/autoload.py installs this as rospy is imported; the world node
-and the batch runner's warm interpreters install it themselves).
+runner's and the grader's SIGINT at a run's end) exits up to 0.5 s late. The simulator and
+the tools start and stop many nodes (every run of the batch runner, the grader and the
+tests), so every node of the project's environment wakes that thread and the sim-time
+sleepers once more after the flag is up (lockstep/autoload.py installs this as rospy is
+imported; the world node and the batch runner's warm interpreters install it themselves).
 """
 import rospy.core
 import rospy.rostime

@@ -78,8 +78,8 @@ def write_replay(folder, name, replay):
 def write_replay_file(folder, name, path):
     """write_replay for a replay kept as JSON in the file `path` (the batch runner's
     runs/<run_id>.replay.json): its text goes into the page's data as it is, unparsed (a
-    class's report holds 180 of them, 1-4 MB each: parsed and written again, they took
-    the report 40 s)."""
+    class's report holds a replay of megabytes for every run: parsed and written again,
+    they were most of the report's time)."""
     with open(path, encoding="utf-8") as source:
         text = source.read()
     return _write_replay(folder, name, text, _title(text) or name)
