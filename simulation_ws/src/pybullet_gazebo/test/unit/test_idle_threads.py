@@ -38,13 +38,15 @@ for line in sys.stdin:
     print("done " + line.strip(), flush=True)
 """
 
-# Spins for `spin` s, then sleeps reading stdin.
+# Spins until a line comes on stdin, then sleeps reading stdin. It spins until told, not for
+# a set time: on a loaded machine it may get too little CPU in a set time to be taken for a
+# busy loop before it stops.
 SPIN_THEN_SLEEP = """
-import sys, time
+import select, sys
 print("ready", flush=True)
-end = time.monotonic() + float(sys.argv[1])
-while time.monotonic() < end:
+while not select.select([sys.stdin], [], [], 0)[0]:
     pass
+sys.stdin.readline()
 print("asleep", flush=True)
 sys.stdin.readline()
 """
@@ -110,7 +112,7 @@ def test_waits_until_the_child_is_done_with_each_message(child):
 
 
 def test_a_busy_loop_is_found_and_not_waited_for(child):
-    spinner = child(SPIN_THEN_SLEEP, "30")
+    spinner = child(SPIN_THEN_SLEEP)
     watch = IdleWatch()
     watch.watch([spinner.pid])
     start = time.monotonic()
@@ -120,10 +122,12 @@ def test_a_busy_loop_is_found_and_not_waited_for(child):
 
 
 def test_a_busy_loop_that_went_to_sleep_is_waited_for_again(child):
-    spinner = child(SPIN_THEN_SLEEP, "0.3")
+    spinner = child(SPIN_THEN_SLEEP)
     watch = IdleWatch()
     watch.watch([spinner.pid])
     assert settle(watch) is None and list(watch.spinners()) == [spinner.pid]
+    spinner.stdin.write("sleep\n")
+    spinner.stdin.flush()
     assert spinner.stdout.readline().strip() == "asleep"
     time.sleep(0.05)
     assert watch.busy() is None and watch.spinners() == {}
