@@ -12,8 +12,13 @@ the same sim time as in process):
   scan before the drive's next update), take the scan stamped dt after the last one as the
   observation, then /gazebo/pause_physics, so the agent may think as long as it likes (an
   agent that computes for long would otherwise be stepped past after lockstep_timeout).
-Reset: pause, /gazebo/reset_simulation (sim time 0), /gazebo/set_model_state to the start
-pose, unpause, take the first scan (stamped one physics step), pause.
+Reset: pause, subscribe to the scans and /odom anew (a message from before the reset could
+carry the stamp of one after it), /gazebo/reset_simulation (sim time 0),
+/gazebo/set_model_state to the start pose, unpause, take the first scan (stamped one physics
+step), pause.
+Lockstep waits for this process by its reports (the handshake), as for any controller: for
+each scan and odometry to be taken in, for the main thread to be done with what a callback
+handed it, and, at an unpause, for the command published before it.
 The pose is /odom's (the drive's odometrySource world: the true pose) stamped with the scan's
 sim time (after a reset both are first due at the first physics step, then every 0.05 s);
 contacts come from /gazebo/contacts. The environment's turning must be the simulator's
@@ -93,37 +98,48 @@ class RosSim:
         if self._spawn is None and laser_noise is not None:
             rospy.logwarn("m2wr_gym: m2wr is already in the simulator; laser_noise=%s is not "
                           "applied (its URDF's noise is)", laser_noise)
-        self._scans = queue.Queue()
         self._lock = threading.Lock()
         self._odom = None
         self._contacts = []                     # (stamp, touching names) as published
-        # the agent thinks on wall time while physics is paused: lockstep watches this
-        # process in /proc rather than by its reports (docs/lockstep.md)
-        from pybullet_gazebo.ros.lockstep import rospy_hooks
-        rospy_hooks.proc_watch_instead()
         self._cmd = rospy.Publisher(COMMAND_TOPIC, Twist, queue_size=10)
-        self._subs = [
-            rospy.Subscriber(SCAN_TOPIC, LaserScan, self._scans.put, queue_size=100),
-            rospy.Subscriber(ODOM_TOPIC, Odometry, self._on_odom, queue_size=100),
-            rospy.Subscriber(CONTACTS_TOPIC, ContactsState, self._on_contacts, queue_size=100),
-        ]
-        self._connected = False                 # once m2wr is there (it may be spawned at reset)
+        self._contacts_sub = rospy.Subscriber(CONTACTS_TOPIC, ContactsState,
+                                              self._on_contacts, queue_size=100)
+        self._subs = []                         # scan and odom, subscribed anew at each reset
+        self._topics = (LaserScan, Odometry)
         self._command = (0.0, 0.0)
         self._time = None
+
+    def _subscribe(self):
+        """Scans and odometry on new connections, each into its own queue or slot: after a
+        reset, sim time starts again at 0, so a message from before it (still on its way when
+        reset_simulation answered) can carry the very stamp that the reset's own observation
+        has. On a new connection none can come."""
+        rospy = self._rospy
+        for sub in self._subs:
+            sub.unregister()
+        scans = self._scans = queue.Queue()
+        with self._lock:
+            self._odom = None
+        slot = object()                          # this subscription's, not an older one's
+        self._odom_slot = slot
+
+        def on_odom(msg):
+            with self._lock:
+                if self._odom_slot is slot:
+                    self._odom = msg
+        scan_type, odom_type = self._topics
+        self._subs = [rospy.Subscriber(SCAN_TOPIC, scan_type, scans.put, queue_size=100),
+                      rospy.Subscriber(ODOM_TOPIC, odom_type, on_odom, queue_size=100)]
 
     def _wait_for_connections(self):
         import time
         deadline = time.monotonic() + self.timeout
         while self._cmd.get_num_connections() == 0 or \
-                any(s.get_num_connections() == 0 for s in self._subs[:2]):
+                any(s.get_num_connections() == 0 for s in self._subs):
             if time.monotonic() > deadline:
                 raise RosSimError("no connection on %s / %s / %s within %g s"
                                   % (COMMAND_TOPIC, SCAN_TOPIC, ODOM_TOPIC, self.timeout))
             time.sleep(0.02)
-
-    def _on_odom(self, msg):
-        with self._lock:
-            self._odom = msg
 
     def _on_contacts(self, msg):
         names = tuple(sorted({s.collision2_name for s in msg.states}))
@@ -149,7 +165,7 @@ class RosSim:
                 return msg
             if stamp < stamp_wanted and self._time is not None and stamp > self._time + _SLACK:
                 self._publish(self._command)     # an intermediate scan of this step
-            # else: a scan from before the reset, still in the queue
+            # else: before the last observation (none come on a connection made at the reset)
 
     def _spawn_at(self, x, y, yaw):
         """m2wr into the simulator at the first start pose (its reset pose from then on)."""
@@ -167,10 +183,9 @@ class RosSim:
         from gazebo_msgs.msg import ModelState
         if self._spawn is not None:
             self._spawn_at(x, y, yaw)
-        if not self._connected:
-            self._wait_for_connections()
-            self._connected = True
         self._pause()
+        self._subscribe()
+        self._wait_for_connections()
         self._reset_sim()
         state = ModelState()
         state.model_name = ROBOT
@@ -182,7 +197,6 @@ class RosSim:
             raise RosSimError("set_model_state failed: %s" % answer.status_message)
         with self._lock:
             self._contacts = [(0.0, ())]
-            self._odom = None
         self._command = (0.0, 0.0)
         self._time = None
         self._unpause()
@@ -242,8 +256,9 @@ class RosSim:
                         msg.header.stamp.to_sec(), touched)
 
     def close(self):
-        for sub in getattr(self, "_subs", []):
-            sub.unregister()
+        for sub in getattr(self, "_subs", []) + [getattr(self, "_contacts_sub", None)]:
+            if sub is not None:
+                sub.unregister()
         if getattr(self, "_cmd", None) is not None:
             try:
                 self._publish((0.0, 0.0))

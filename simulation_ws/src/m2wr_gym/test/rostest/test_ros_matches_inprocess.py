@@ -12,11 +12,13 @@ spawned there in a fresh world): Bullet's contact cache. Measured: 0 to 1e-4 m. 
 taken at a different sim time would show at once: 1 mm is 2 ms of driving at 0.5 m/s.
 """
 import math
+import time
 import unittest
 
 import numpy as np
 import rospy
 import rostest
+from std_srvs.srv import Empty
 
 from m2wr_gym.env import M2wrEnv
 from m2wr_gym.sim_ros import RosSimError
@@ -42,7 +44,14 @@ class RosMatchesInProcess(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_ros_matches_inprocess")
         cls.ros = rollout(M2wrEnv(backend="ros", **KWARGS))
-        cls.ros_again = rollout(M2wrEnv(backend="ros", **KWARGS))     # after a reset
+        # the second run's environment is made while the world runs on unpaused from sim
+        # time 0 (another program reset and unpaused it): the scans it sends meanwhile carry
+        # the stamps of the run's own after its reset, and must not be taken for them
+        again = M2wrEnv(backend="ros", **KWARGS)
+        rospy.ServiceProxy("/gazebo/reset_simulation", Empty)()
+        rospy.ServiceProxy("/gazebo/unpause_physics", Empty)()
+        time.sleep(0.5)
+        cls.ros_again = rollout(again)
         cls.local = rollout(M2wrEnv(**KWARGS))
 
     def test_same_number_of_steps_of_exactly_dt(self):

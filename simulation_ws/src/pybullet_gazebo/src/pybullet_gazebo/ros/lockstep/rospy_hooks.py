@@ -314,21 +314,6 @@ def _counted_from(now):
     return now if start is None else type(now)(0, start)     # (genpy carries the seconds)
 
 
-def proc_watch_instead():
-    """This process sends no reports: lockstep watches it in /proc, as a process outside the
-    project's environment. For a process driven by the wall clock between the simulator's
-    pause and unpause (the Gym environment's ROS backend: its agent thinks while physics is
-    paused, then publishes and unpauses), whose threads' states tell more than its
-    callbacks. Call after rospy.init_node; without the hooks it does nothing."""
-    global _reports, _publisher
-    _reports = False
-    if TRACKER is not None:
-        TRACKER.reporting = lambda: False
-    if _publisher is not None:
-        _publisher.unregister()
-        _publisher = None
-
-
 def watch_only():
     """This process only watches (records, measures): lockstep need not wait for it, as for a
     display. Call after rospy.init_node; without the hooks it does nothing."""
