@@ -47,6 +47,8 @@ class BindingContext:
     debug: bool = False
     watch_rate: float = 0.0                       # [Hz wall] ~watch_rate (watch_rate.py)
     commands_by_node: Counter = field(default_factory=Counter)   # for the run summary
+    # (resolved topic) -> None: lockstep's main thread reads this topic (lockstep/inbox.py)
+    read_in_main_thread: Callable[[str], None] = lambda topic: None
 
 
 class Binding:
@@ -132,7 +134,9 @@ class DriveBinding(Binding):
         self.tf = context.tf_publisher() if part.publish_odom_tf else None
         # tcp_nodelay: a transport hint only (the command comes at once, not after the
         # publisher's kernel has waited for the ACK of the last one)
-        self.subscribers.append(rospy.Subscriber(self.topic(self.names.command_topic), Twist,
+        command_topic = self.topic(self.names.command_topic)
+        context.read_in_main_thread(rospy.resolve_name(command_topic))
+        self.subscribers.append(rospy.Subscriber(command_topic, Twist,
                                                  self._on_command, queue_size=1,
                                                  tcp_nodelay=True))
 

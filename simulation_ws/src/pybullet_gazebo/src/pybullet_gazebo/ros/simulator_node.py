@@ -47,6 +47,7 @@ from pybullet_gazebo.ros.gazebo_services import GazeboServices
 from pybullet_gazebo.ros.lockstep import REPORT_TOPIC, rospy_hooks
 from pybullet_gazebo.ros.lockstep.gate import Lockstep, sort_controllers
 from pybullet_gazebo.ros.lockstep.idle_threads import IdleWatch
+from pybullet_gazebo.ros.lockstep import inbox as lockstep_inbox
 from pybullet_gazebo.ros.lockstep.node_processes import MASTER, NodeProcesses
 from pybullet_gazebo.ros.lockstep.own_receivers import OwnReceivers
 from pybullet_gazebo.ros.lockstep.board import Board
@@ -85,8 +86,13 @@ class SimulatorNode:
         self.pacer = RealTimePacer(self.real_time_factor, self.world.sim_time)
         self._node_processes = NodeProcesses(rospy.get_name())
         self._busy_loops = set()            # lockstep: threads taken for busy loops (named)
-        own_receivers = OwnReceivers()
-        self.board = self._report_sub = None
+        self.board = self._report_sub = self.inbox = None
+        if params.lockstep:
+            # the main thread reads the reports and commands it waits for (inbox.py)
+            self.inbox = lockstep_inbox.install(lockstep_inbox.Inbox(
+                [rospy.resolve_name(REPORT_TOPIC)], warn=rospy.logwarn))
+        own_receivers = OwnReceivers(
+            held=(lambda: self.inbox.parked) if self.inbox is not None else frozenset)
         if params.lockstep:
             # the handshake: the simulator's own counts (never reported) against each
             # controller's reports (lockstep/)
@@ -94,7 +100,8 @@ class SimulatorNode:
             self.board = Board(rospy.get_name(), own.counts, ServiceProviders(rospy.get_name()),
                                own_inbound=rospy_hooks.inbound_connections,
                                own_answered=own.take_answered,
-                               own_outbound=rospy_hooks.outbound_connections)
+                               own_outbound=rospy_hooks.outbound_connections,
+                               inbox=self.inbox)
             own.on_change = self.board.notify
             # no Nagle on the reports: a report held back for the last one's ACK would hold
             # the simulation for the receiver's delayed ACK
@@ -102,7 +109,8 @@ class SimulatorNode:
                                                 queue_size=None, tcp_nodelay=True)
         self.lockstep = Lockstep(
             params.lockstep, params.lockstep_timeout, self.board,
-            IdleWatch(own_busy=own_receivers.busy, own_moved=own_receivers.moved,
+            IdleWatch(own_busy=lambda: self.inbox.poll() or own_receivers.busy(),
+                      own_moved=lambda: self.inbox.poll() or own_receivers.moved(),
                       on_spin=self._note_busy_loop)
             if params.lockstep else None,
             is_shutdown=rospy.is_shutdown, is_paused=lambda: self.paused,
@@ -121,6 +129,8 @@ class SimulatorNode:
         self._running = False                     # run() is stepping
         self._tf_publisher = None
         self._binding_context = BindingContext(self._tf,
+                                               read_in_main_thread=self.inbox.add
+                                               if self.inbox is not None else lambda topic: None,
                                                debug=params.debug, watch_rate=params.watch_rate)
         self._last_touching = []
         # publication periods in whole physics steps, so they never drift
@@ -267,8 +277,13 @@ class SimulatorNode:
             if self.paused:
                 if self.clock_pub is not None:
                     self.clock_pub.flush()        # displays learn the paused time
-                time.sleep(0.01)
+                if self.inbox is not None:
+                    self.inbox.poll(0.01)         # commands and reports come while paused
+                else:
+                    time.sleep(0.01)
                 continue
+            if self.inbox is not None:
+                self.inbox.poll()                 # at least once a turn, whoever waits
             if lockstep and self._command_update_next() and not self._settle_loop_nodes():
                 continue                          # paused while waiting: no step now
             with self.lock:
@@ -540,6 +555,8 @@ class SimulatorNode:
             self._disconnect()
 
     def _disconnect(self):
+        if self.inbox is not None:
+            self.inbox.close()                    # rospy's threads end their connections
         if self.window is not None:
             self.window.close()
         if self.web is not None:

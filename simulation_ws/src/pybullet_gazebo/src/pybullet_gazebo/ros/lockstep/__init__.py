@@ -5,7 +5,8 @@ Controller side: tracker.py (is this process done, what has it taken in and writ
 rospy_hooks.py (rospy fed to the tracker, the reports sent), autoload.py (loads the hooks in
 every Python process of the project's environment that imports rospy).
 Simulator side: board.py (the latest report of each controller, and whether they are all done
-with what the simulator sent them), gate.py (the loop steps on only once they are), and the
+with what the simulator sent them), gate.py (the loop steps on only once they are), inbox.py
+(the loop's own thread reads the reports and commands it waits for), and the
 fallback for a controller that cannot report: idle_threads.py (its threads' states in /proc),
 own_receivers.py (the simulator's own reading threads) and node_processes.py (which process
 is which node).

@@ -69,12 +69,15 @@ class NodeReport:
 
 class Board:
     def __init__(self, own_name, own_counts, service_provider=lambda service: None,
-                 own_inbound=None, own_answered=lambda: (), own_outbound=None):
+                 own_inbound=None, own_answered=lambda: (), own_outbound=None, inbox=None):
         """`own_name`: the simulator's node name; `own_counts()`: (taken, written) of the
         simulator's own connections, keyed as in a report; `service_provider(name)`: the
         node that offers a service, or None; `own_inbound()`: the keys of the simulator's
-        subscriber connections now (default: those it has taken something from)."""
+        subscriber connections now (default: those it has taken something from); `inbox`:
+        the Inbox (inbox.py) through which the waiting thread reads reports and commands
+        itself (None: they come from rospy's threads, which notify)."""
         self.own_name = own_name
+        self.inbox = inbox
         self.own_counts = own_counts
         self.own_inbound = own_inbound or (lambda: set(own_counts()[0]))
         # the connections it writes to now: a closed one (a controller that ended, the batch
@@ -108,6 +111,8 @@ class Board:
                     self._remember(self._called, key, node)
             self._version += 1
             self._changed.notify_all()
+        if self.inbox is not None:
+            self.inbox.wake()
 
     @staticmethod
     def _remember(records, key, node):
@@ -126,6 +131,8 @@ class Board:
         with self._changed:
             self._version += 1
             self._changed.notify_all()
+        if self.inbox is not None:
+            self.inbox.wake()
 
     def forget(self, node):
         """`node` left: its report no longer counts (its connections are gone too)."""
@@ -151,6 +158,8 @@ class Board:
         """The first of `nodes` (reporting controllers) not yet done with what it was sent,
         with why, as (node, why); None when all are done. A node stepped past at a time-out
         (`silent`) is skipped until its reports add up again."""
+        if self.inbox is not None:
+            self.inbox.poll()            # what has come is read first
         taken_own, written_own = self.own_counts()
         inbound = self.own_inbound()
         outbound = self.own_outbound()
@@ -242,6 +251,10 @@ class Board:
             left = deadline - time.monotonic()
             if left <= 0:
                 return busy
-            with self._changed:
+            if self.inbox is not None:
                 if self._version == version:        # nothing came since the look
+                    self.inbox.poll(min(left, 0.05))    # reads what comes (or is woken)
+                continue
+            with self._changed:
+                if self._version == version:
                     self._changed.wait(min(left, 0.05))

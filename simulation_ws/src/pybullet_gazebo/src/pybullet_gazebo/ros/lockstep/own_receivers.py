@@ -33,7 +33,10 @@ def _is_reader(thread):
 
 
 class OwnReceivers:
-    def __init__(self):
+    def __init__(self, held=frozenset):
+        """`held()`: native ids of reader threads whose connection the main thread reads
+        (inbox.py): they sleep until it is given back, and are not readers meanwhile."""
+        self.held = held
         self._threads = ()
         self._files = {}            # reader tid -> (fds of its stat, syscall and schedstat)
         self._runs = {}             # reader tid -> its schedstat at the last look
@@ -76,7 +79,10 @@ class OwnReceivers:
         self.tids()
         runs = self._runs
         runs.clear()
+        held = self.held()
         for tid, (stat_fd, syscall_fd, sched_fd) in self._files.items():
+            if tid in held:
+                continue
             try:
                 runs[tid] = os.pread(sched_fd, 128, 0)          # before its state
                 if state_of(os.pread(stat_fd, 512, 0)) != ord("S"):
@@ -90,7 +96,10 @@ class OwnReceivers:
 
     def moved(self):
         """After busy() found all readers idle: True if one has run since or is running."""
+        held = self.held()
         for tid, (stat_fd, _, sched_fd) in self._files.items():
+            if tid in held:
+                continue
             try:
                 if state_of(os.pread(stat_fd, 512, 0)) != ord("S") or \
                         os.pread(sched_fd, 128, 0) != self._runs.get(tid):
