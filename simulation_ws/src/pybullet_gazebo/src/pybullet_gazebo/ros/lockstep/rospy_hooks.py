@@ -141,14 +141,35 @@ def install(report=True):
     def tracked_queued_init(self, connection, queue_size):
         queued_init(self, connection, queue_size)
         self._lockstep_pending = 0
+        # (/rosout stays queued: no controller waits for it, so its write is left to the
+        # queue's thread, off the path to the next report)
+        self._lockstep_at_once = getattr(connection.protocol, "resolved_name", None) \
+            not in NOT_COUNTED
         connection._lockstep_queue = self
 
     def counted_queued_write(self, data):
         with self._lock:
+            if _listening and self._lockstep_at_once and self._lockstep_pending == 0 and \
+                    not self._error and \
+                    _room_for(self._connection, len(data)):
+                return written_at_once(self._connection, data)
             if not (self._queue_size > 0 and len(self._queue) == self._queue_size):
                 self._lockstep_pending += 1     # (a full queue drops its oldest: no change)
                 waiting.add(self)
         return queued_write(self, data)
+
+    def written_at_once(connection, data):
+        """While a simulator listens, a message for a queued connection with nothing queued
+        or being written is written by the publishing thread (under the queue's lock, so
+        the queue's thread cannot start a write meanwhile), as that thread would write it.
+        It is out when publish() returns: the subscriber gets it, and the process is done,
+        without waiting for the queue's thread to wake and take the GIL."""
+        result = write_data(connection, data)
+        protocol = connection.protocol
+        if isinstance(protocol, publishing) and protocol.resolved_name not in NOT_COUNTED:
+            tracker.wrote(protocol.resolved_name, connection.endpoint_id,
+                          _peer_port(connection))
+        return result
     tcpros_pubsub.QueuedConnection.__init__ = tracked_queued_init
     tcpros_pubsub.QueuedConnection.write_data = counted_queued_write
 
@@ -397,6 +418,22 @@ def _open_publisher():
                                      subscriber_listener=_OnConnect())
 
 
+def _room_for(connection, size):
+    """Whether `size` bytes fit in the connection's socket now, so that writing them cannot
+    block the publishing thread; a subscriber that does not keep up gets rospy's queue. A
+    writable TCP socket has at least a few kB free: larger messages keep the queue."""
+    sock = getattr(connection, "socket", None)
+    if sock is None or size > 4096:
+        return False
+    try:
+        return bool(select.select([], [sock], [], 0)[1])
+    except (OSError, ValueError):
+        return False
+
+
+_listening = False          # the last _reporting() found a simulator listening
+
+
 def _reporting():
     """Whether a simulator listens: a live connection on the report publisher. rospy keeps a
     connection whose subscriber has gone until a write to it fails, and the first write after
@@ -405,15 +442,18 @@ def _reporting():
     (a tool's node spawning the robot, run after run) then held that simulator for a
     lockstep_timeout, waiting for word of the call. So connections whose peer has closed
     are dropped first, and the report waits for the next simulator's connection."""
+    global _listening
     publisher = _publisher
     if publisher is None:
+        _listening = False
         return False
     impl = publisher.impl
     for connection in list(impl.connections):
         if _peer_closed(connection):
             impl.remove_connection(connection)
             connection.close()
-    return publisher.get_num_connections() > 0
+    _listening = publisher.get_num_connections() > 0
+    return _listening
 
 
 def _peer_closed(connection):
