@@ -81,7 +81,10 @@ class Inbox:
             self._held[held.fd] = held
             self._buffered = self._buffered or held.buffered
             self.parked.add(tid)
-            self._poller.register(held.fd, select.EPOLLIN | select.EPOLLRDHUP)
+            try:
+                self._poller.register(held.fd, select.EPOLLIN | select.EPOLLRDHUP)
+            except FileExistsError:     # its number was a closed connection's, still listed
+                self._poller.modify(held.fd, select.EPOLLIN | select.EPOLLRDHUP)
         self.wake()
         try:
             # rospy may close the connection from another thread (a second connection to
