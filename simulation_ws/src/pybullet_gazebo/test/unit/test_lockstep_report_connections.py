@@ -54,3 +54,25 @@ def test_a_live_connection_is_kept_whatever_is_waiting_to_be_read(monkeypatch):
 def test_no_publisher_no_report(monkeypatch):
     monkeypatch.setattr(rospy_hooks, "_publisher", None)
     assert not rospy_hooks._reporting()
+
+
+def test_a_connection_asked_for_its_port_before_it_connects_is_named_by_its_port_once_it_has():
+    """rospy lists a subscriber's connection before it connects; lockstep may look at it
+    then (the simulator asks for its connections at every wait). Its port, 0 then, must not
+    stick: the controller's reports name the connection by its real port, and a command on
+    a connection named 0 would never be waited for."""
+    connection = Connection(None)
+    assert rospy_hooks._local_port(connection) == 0
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)
+    client = socket.create_connection(listener.getsockname())
+    server, _ = listener.accept()
+    try:
+        connection.socket = client
+        assert rospy_hooks._local_port(connection) == client.getsockname()[1]
+        served = Connection(server)
+        assert rospy_hooks._peer_port(served) == client.getsockname()[1]
+    finally:
+        for sock in (client, server, listener):
+            sock.close()

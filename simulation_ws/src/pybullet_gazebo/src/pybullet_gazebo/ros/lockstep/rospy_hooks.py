@@ -373,23 +373,24 @@ def outbound_connections():
 
 
 def _local_port(connection):
-    port = getattr(connection, "_lockstep_port", None)
-    if port is None:
-        try:
-            port = connection.socket.getsockname()[1]
-        except (AttributeError, OSError):
-            port = 0
-        connection._lockstep_port = port
-    return port
+    return _port(connection, "getsockname")
 
 
 def _peer_port(connection):
+    return _port(connection, "getpeername")
+
+
+def _port(connection, end):
+    """The TCP port of the connection's subscriber end, kept once known. 0 while it has no
+    socket yet (rospy lists a subscriber's connection before it connects) and not kept: a 0
+    kept would name the connection wrongly for good, and a report's counts on it would never
+    be matched to the simulator's."""
     port = getattr(connection, "_lockstep_port", None)
     if port is None:
         try:
-            port = connection.socket.getpeername()[1]
+            port = getattr(connection.socket, end)()[1]
         except (AttributeError, OSError):
-            port = 0
+            return 0
         connection._lockstep_port = port
     return port
 
