@@ -2,23 +2,27 @@
 what the environments use when backend="ros" (ids M2wrAvoidRos-v0, M2wrGoalRos-v0).
 
 Needs a master and the stand-in started with lockstep, e.g.
-    roslaunch my_worlds launch_world.launch world:=world02 gui:=false real_time_factor:=0 lockstep:=true
+    roslaunch my_worlds launch_world.launch world:=world02 gui:=false real_time_factor:=0 \
+        lockstep:=true contacts:=true
 m2wr is spawned if it is not in the world (with laser_noise when given).
 
 Per environment step (exact: each step is dt of sim time and the action reaches the drive at
 the same sim time as in process):
-  publish the action on /cmd_vel, /gazebo/unpause_physics, answer every intermediate scan of
-  /m2wr/laser/scan with the same command (lockstep waits until this process is done with each
-  scan before the drive's next update), take the scan stamped dt after the last one as the
-  observation, then /gazebo/pause_physics, so the agent may think as long as it likes (an
-  agent that computes for long would otherwise be stepped past after lockstep_timeout).
+  publish the action on /cmd_vel, /gazebo/unpause_physics; the scan callback answers every
+  intermediate scan of /m2wr/laser/scan with the same command, and at the scan stamped dt
+  after the last one calls /gazebo/pause_physics and hands that scan to the main thread as
+  the observation, so the agent may think as long as it likes (an agent that computes for
+  long would otherwise be stepped past after lockstep_timeout).
 Reset: pause, subscribe to the scans and /odom anew (a message from before the reset could
 carry the stamp of one after it), /gazebo/reset_simulation (sim time 0),
-/gazebo/set_model_state to the start pose, unpause, take the first scan (stamped one physics
-step), pause.
+/gazebo/set_model_state to the start pose, unpause; the callback pauses at the first scan
+(stamped one physics step).
 Lockstep waits for this process by its reports (the handshake), as for any controller: for
-each scan and odometry to be taken in, for the main thread to be done with what a callback
-handed it, and, at an unpause, for the command published before it.
+each scan and odometry to be taken in, and, at an unpause, for the command published before
+it. The answers and the pause are made in the scan callback itself, not by the main thread,
+because lockstep counts a callback as work until it returns: what a callback hands to
+another thread is waited for only while that thread is known to read it, which a queue made
+at the reset is not until its first wait.
 The pose is /odom's (the drive's odometrySource world: the true pose) stamped with the scan's
 sim time (after a reset both are first due at the first physics step, then every 0.05 s);
 contacts come from /gazebo/contacts. The environment's turning must be the simulator's
@@ -70,10 +74,15 @@ class RosSim:
         except rospy.ROSException:
             raise RosSimError("no simulator answers /gazebo/%s within %g s; start "
                               "one: roslaunch my_worlds launch_world.launch gui:=false "
-                              "real_time_factor:=0 lockstep:=true" % (name, timeout)) from None
+                              "real_time_factor:=0 lockstep:=true contacts:=true"
+                              % (name, timeout)) from None
         if not rospy.get_param("/gazebo/lockstep", False):
             raise RosSimError("the simulator runs without lockstep, so steps would not be exact;"
                               " start it with lockstep:=true")
+        if not rospy.get_param("/gazebo/contacts", False):
+            raise RosSimError("the simulator does not publish /gazebo/contacts, so a touch would "
+                              "go unseen (no crash penalty, no end of episode, unlike in "
+                              "process); start it with contacts:=true")
         running = bool(rospy.get_param("/gazebo/legacy_mode", False))
         if running != bool(legacy_mode):
             raise RosSimError(
@@ -105,6 +114,8 @@ class RosSim:
         self._contacts_sub = rospy.Subscriber(CONTACTS_TOPIC, ContactsState,
                                               self._on_contacts, queue_size=100)
         self._subs = []                         # scan and odom, subscribed anew at each reset
+        self._observations = queue.Queue()      # the scans that end a step (or the reset)
+        self._wanted = None                     # [s] the stamp of the scan that ends this step
         self._topics = (LaserScan, Odometry)
         self._command = (0.0, 0.0)
         self._time = None
@@ -117,18 +128,21 @@ class RosSim:
         rospy = self._rospy
         for sub in self._subs:
             sub.unregister()
-        scans = self._scans = queue.Queue()
         with self._lock:
             self._odom = None
         slot = object()                          # this subscription's, not an older one's
-        self._odom_slot = slot
+        self._slot = slot
+
+        def on_scan(msg):
+            if self._slot is slot:
+                self._on_scan(msg)
 
         def on_odom(msg):
             with self._lock:
-                if self._odom_slot is slot:
+                if self._slot is slot:
                     self._odom = msg
         scan_type, odom_type = self._topics
-        self._subs = [rospy.Subscriber(SCAN_TOPIC, scan_type, scans.put, queue_size=100),
+        self._subs = [rospy.Subscriber(SCAN_TOPIC, scan_type, on_scan, queue_size=100),
                       rospy.Subscriber(ODOM_TOPIC, odom_type, on_odom, queue_size=100)]
 
     def _wait_for_connections(self):
@@ -151,21 +165,32 @@ class RosSim:
         msg.linear.x, msg.angular.z = command
         self._cmd.publish(msg)
 
-    def _next_scan(self, stamp_wanted):
-        """Waits for the scan stamped `stamp_wanted` [s]; answers earlier ones with the
-        current command (lockstep needs an answer to each), drops stale ones."""
-        while True:
-            try:
-                msg = self._scans.get(timeout=self.timeout)
-            except queue.Empty:
-                raise RosSimError("no scan stamped %.3f s on %s within %g s of wall time"
-                                  % (stamp_wanted, SCAN_TOPIC, self.timeout)) from None
-            stamp = msg.header.stamp.to_sec()
-            if abs(stamp - stamp_wanted) <= _SLACK:
-                return msg
-            if stamp < stamp_wanted and self._time is not None and stamp > self._time + _SLACK:
-                self._publish(self._command)     # an intermediate scan of this step
-            # else: before the last observation (none come on a connection made at the reset)
+    def _on_scan(self, msg):
+        """A scan, in its callback: an intermediate one of this step is answered with the
+        step's command (lockstep needs an answer to each); the one stamped `_wanted` pauses
+        physics and goes to the main thread."""
+        wanted = self._wanted
+        if wanted is None:
+            return                               # not stepping
+        stamp = msg.header.stamp.to_sec()
+        if abs(stamp - wanted) <= _SLACK:
+            self._wanted = None
+            self._pause()
+            self._observations.put(msg)
+        elif stamp < wanted and self._time is not None and stamp > self._time + _SLACK:
+            self._publish(self._command)
+
+    def _step_until(self, stamp_wanted):
+        """Unpauses and waits for the scan stamped `stamp_wanted` [s] (physics is paused at
+        it by then)."""
+        self._wanted = stamp_wanted
+        self._unpause()
+        try:
+            return self._observations.get(timeout=self.timeout)
+        except queue.Empty:
+            self._wanted = None
+            raise RosSimError("no scan stamped %.3f s on %s within %g s of wall time"
+                              % (stamp_wanted, SCAN_TOPIC, self.timeout)) from None
 
     def _spawn_at(self, x, y, yaw):
         """m2wr into the simulator at the first start pose (its reset pose from then on)."""
@@ -199,9 +224,7 @@ class RosSim:
             self._contacts = [(0.0, ())]
         self._command = (0.0, 0.0)
         self._time = None
-        self._unpause()
-        msg = self._next_scan(self.physics_step)
-        self._pause()
+        msg = self._step_until(self.physics_step)
         self._time = msg.header.stamp.to_sec()
         return self._snapshot(msg, (), start=(x, y, yaw))
 
@@ -209,9 +232,7 @@ class RosSim:
         start = self._time
         self._command = (float(linear_x), float(angular_z))
         self._publish(self._command)            # the answer to the last observation's scan
-        self._unpause()
-        msg = self._next_scan(start + steps * self.physics_step)
-        self._pause()
+        msg = self._step_until(start + steps * self.physics_step)
         self._time = msg.header.stamp.to_sec()
         with self._lock:
             touched = set()

@@ -3,7 +3,9 @@
 
 Both start m2wr at (0, 8, yaw 0) in world02 with a noiseless laser and take the same 60
 actions (6 s of sim time: straight, turning while driving, turning in place, straight).
-Tolerances, per step: position 1 mm, heading 1 mrad, regions 1 mm; sim times equal.
+Tolerances, per step: position 1 mm, heading 1 mrad, regions 1 mm; sim times equal. Then
+both drive north into a barrier: the touch (/gazebo/contacts over ROS) ends the episode at
+the same step, with the same penalty.
 Both run the same engine with the same 5 ms step, the commands reach the drive at the same
 sim time (lockstep) and the ROS pose is /odom's stamped with the same sim time as the scan,
 so the only possible difference is how m2wr got to its start (the ROS one is reset and
@@ -25,6 +27,22 @@ from m2wr_gym.sim_ros import RosSimError
 
 KWARGS = dict(world="world02", start=[(0.0, 8.0, 0.0)], action="continuous", laser_noise=0.0)
 ACTIONS = ([(0.5, 0.0)] * 15 + [(0.3, 0.6)] * 15 + [(0.0, -0.8)] * 15 + [(0.5, 0.0)] * 15)
+# facing north from (0, 8), straight on into world02's jersey_barrier_0 (in process: the
+# touch ends the episode at the 12th step, y = 8.56)
+INTO_A_WALL = dict(KWARGS, start=[(0.0, 8.0, math.pi / 2)])
+
+
+def until_the_end(env, steps=40):
+    """(touched, terminated, reward) of each step, driving straight on, until the end."""
+    env.reset(seed=0)
+    trace = []
+    for _ in range(steps):
+        _, reward, terminated, truncated, info = env.step(np.array((0.5, 0.0), np.float32))
+        trace.append((info["touched"], terminated, round(float(reward), 4)))
+        if terminated or truncated:
+            break
+    env.close()
+    return trace
 
 
 def rollout(env):
@@ -53,6 +71,8 @@ class RosMatchesInProcess(unittest.TestCase):
         time.sleep(0.5)
         cls.ros_again = rollout(again)
         cls.local = rollout(M2wrEnv(**KWARGS))
+        cls.ros_touch = until_the_end(M2wrEnv(backend="ros", **INTO_A_WALL))
+        cls.local_touch = until_the_end(M2wrEnv(**INTO_A_WALL))
 
     def test_same_number_of_steps_of_exactly_dt(self):
         self.assertEqual(len(self.ros), len(ACTIONS) + 1)
@@ -84,6 +104,12 @@ class RosMatchesInProcess(unittest.TestCase):
 
     def test_ros_runs_repeat(self):
         self.check_close(self.ros, self.ros_again, "ROS run 1 vs 2")
+
+    def test_a_touch_ends_the_episode_at_the_same_step_with_the_same_penalty(self):
+        touched, terminated, _ = self.local_touch[-1]
+        self.assertEqual((touched, terminated), (("jersey_barrier_0",), True), self.local_touch)
+        self.assertLess(len(self.local_touch), 20, self.local_touch)
+        self.assertEqual(self.ros_touch, self.local_touch)
 
     def test_a_turning_the_simulator_does_not_run_is_refused(self):
         """The simulator runs Noetic's drive (legacy_mode:=false): an environment that means
