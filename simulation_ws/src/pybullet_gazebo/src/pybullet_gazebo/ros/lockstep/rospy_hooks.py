@@ -118,14 +118,17 @@ def install(report=True):
     write_data = tcpros_base.TCPROSTransport.write_data
     publishing = tcpros_pubsub.TCPROSPub
 
+    def written_and_counted(transport, data):
+        result = write_data(transport, data)
+        protocol = transport.protocol
+        if isinstance(protocol, publishing) and protocol.resolved_name not in NOT_COUNTED:
+            tracker.wrote(protocol.resolved_name, transport.endpoint_id, _peer_port(transport))
+        return result
+
     def counted_write_data(self, data):
         outer = getattr(self, "_lockstep_queue", None)
         try:
-            result = write_data(self, data)
-            protocol = self.protocol
-            if isinstance(protocol, publishing) and protocol.resolved_name not in NOT_COUNTED:
-                tracker.wrote(protocol.resolved_name, self.endpoint_id, _peer_port(self))
-            return result
+            return written_and_counted(self, data)
         finally:
             if outer is not None:
                 with outer._lock:            # the queue's lock: += and -= from two threads
@@ -152,24 +155,15 @@ def install(report=True):
             if _listening and self._lockstep_at_once and self._lockstep_pending == 0 and \
                     not self._error and \
                     _room_for(self._connection, len(data)):
-                return written_at_once(self._connection, data)
+                # written by the publishing thread (under the queue's lock, so the queue's
+                # thread cannot start a write meanwhile), as that thread would write it: out
+                # when publish() returns, so the subscriber gets it and the process is done
+                # without waiting for the queue's thread to wake and take the GIL
+                return written_and_counted(self._connection, data)
             if not (self._queue_size > 0 and len(self._queue) == self._queue_size):
                 self._lockstep_pending += 1     # (a full queue drops its oldest: no change)
                 waiting.add(self)
         return queued_write(self, data)
-
-    def written_at_once(connection, data):
-        """While a simulator listens, a message for a queued connection with nothing queued
-        or being written is written by the publishing thread (under the queue's lock, so
-        the queue's thread cannot start a write meanwhile), as that thread would write it.
-        It is out when publish() returns: the subscriber gets it, and the process is done,
-        without waiting for the queue's thread to wake and take the GIL."""
-        result = write_data(connection, data)
-        protocol = connection.protocol
-        if isinstance(protocol, publishing) and protocol.resolved_name not in NOT_COUNTED:
-            tracker.wrote(protocol.resolved_name, connection.endpoint_id,
-                          _peer_port(connection))
-        return result
     tcpros_pubsub.QueuedConnection.__init__ = tracked_queued_init
     tcpros_pubsub.QueuedConnection.write_data = counted_queued_write
 
