@@ -56,8 +56,6 @@ class RosSim:
         import rospy
         from geometry_msgs.msg import Twist
         from gazebo_msgs.msg import ContactsState
-        from nav_msgs.msg import Odometry
-        from sensor_msgs.msg import LaserScan
         from std_srvs.srv import Empty
         from gazebo_msgs.srv import (GetPhysicsProperties, GetWorldProperties, SetModelState,
                                      SpawnModel)
@@ -116,7 +114,6 @@ class RosSim:
         self._subs = []                         # scan and odom, subscribed anew at each reset
         self._observations = queue.Queue()      # the scans that end a step (or the reset)
         self._wanted = None                     # [s] the stamp of the scan that ends this step
-        self._topics = (LaserScan, Odometry)
         self._command = (0.0, 0.0)
         self._time = None
 
@@ -125,6 +122,8 @@ class RosSim:
         reset, sim time starts again at 0, so a message from before it (still on its way when
         reset_simulation answered) can carry the very stamp that the reset's own observation
         has. On a new connection none can come."""
+        from nav_msgs.msg import Odometry
+        from sensor_msgs.msg import LaserScan
         rospy = self._rospy
         for sub in self._subs:
             sub.unregister()
@@ -141,9 +140,8 @@ class RosSim:
             with self._lock:
                 if self._slot is slot:
                     self._odom = msg
-        scan_type, odom_type = self._topics
-        self._subs = [rospy.Subscriber(SCAN_TOPIC, scan_type, on_scan, queue_size=100),
-                      rospy.Subscriber(ODOM_TOPIC, odom_type, on_odom, queue_size=100)]
+        self._subs = [rospy.Subscriber(SCAN_TOPIC, LaserScan, on_scan, queue_size=100),
+                      rospy.Subscriber(ODOM_TOPIC, Odometry, on_odom, queue_size=100)]
 
     def _wait_for_connections(self):
         import time
