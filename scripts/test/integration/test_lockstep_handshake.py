@@ -54,6 +54,34 @@ def test_the_same_run_to_the_bit_with_both_cores_busy(tmp_path, controller, requ
         assert "watched in /proc" not in line, line
 
 
+def ticks_and_scans(log_dir):
+    """tick_reader.py's notes: [(sim time of a turn, stamp of the latest scan it had)] [ns]."""
+    with open(os.path.join(str(log_dir), "ticks.txt")) as notes:
+        return [tuple(map(int, line.split())) for line in notes if line.strip()]
+
+
+@pytest.mark.parametrize("busy_cores", [0, 2])
+def test_a_lone_loop_gets_its_tick_with_the_readings_and_acts_on_the_scan_of_its_time(
+        tmp_path, busy_cores):
+    """A lone loop node's tick goes out with the readings and the word on them
+    (lockstep/tick_word.py): its process sets the tick only once the scan of that time has
+    gone through its callback, so every turn of a rospy.Rate(20) loop sees the scan stamped
+    with its own sim time, with both cores busy too. With `rostopic hz` reading the scan
+    beside it, each tick waits for the readings' report instead: the same track, to the bit."""
+    lone = run(tmp_path / "lone", "--controller", "ticks", "--busy-cores", str(busy_cores))
+    notes = ticks_and_scans(tmp_path / "lone")
+    assert len(notes) > 100, notes
+    late = [(now, scan) for now, scan in notes[1:] if now != scan]
+    assert not late, "turns that did not see the scan of their time: %s" % late[:5]
+    assert "with the readings and the word on them" in lockstep_line(lone)
+    if busy_cores:
+        return
+    beside = run(tmp_path / "beside", "--controller", "ticks", "--scan-reader")
+    assert lone["track_sha256"] == beside["track_sha256"], (lone["m2wr"], beside["m2wr"])
+    line = lockstep_line(beside)
+    assert "with the readings and the word" not in line and "0 time-outs" in line, line
+
+
 def test_a_controller_in_another_pid_namespace_is_waited_for_exactly(
         tmp_path, tutorial_on_an_idle_machine):
     here = tutorial_on_an_idle_machine

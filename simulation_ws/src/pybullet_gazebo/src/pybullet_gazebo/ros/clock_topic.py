@@ -43,10 +43,14 @@ class _Watcher:
 
 
 class ClockTopic:
-    def __init__(self, clock_rate, watch_rate, loop_nodes, clock=time.monotonic):
+    def __init__(self, clock_rate, watch_rate, loop_nodes, clock=time.monotonic,
+                 before_tick=None):
         """`clock_rate` [Hz sim]: ~pub_clock_frequency; `watch_rate` [Hz wall]: ~watch_rate;
-        `loop_nodes()`: the names of the loop nodes (see above), now."""
+        `loop_nodes()`: the names of the loop nodes (see above), now; `before_tick(connection)`:
+        called before each tick is written to a subscriber (lockstep's word on it,
+        lockstep/tick_word.py)."""
         self.publisher = DirectPublisher("/clock", Clock)
+        self._before_tick = before_tick
         self._period = 1.0 / clock_rate if clock_rate > 0 else 0.0      # [s] sim
         self._wall_limit = topic_limit(watch_rate, clock_rate)         # [Hz] wall
         self._limited = watch_rate > 0
@@ -62,7 +66,7 @@ class ClockTopic:
         msg = Clock(stamp)
         self._latest = msg
         if not self._limited and loop_nodes:
-            self.publisher.publish(msg)
+            self._publish(msg)
             return
         now = stamp.to_sec()
         nodes = self._loop_nodes()
@@ -86,14 +90,14 @@ class ClockTopic:
                 return True
             return False
 
-        self.publisher.publish(msg, share)
+        self._publish(msg, share)
 
     def publish_to_loop_nodes(self, stamp, nodes=None):
         """The tick at `stamp` to the loop nodes only, or to those of them named in `nodes`
         (lockstep: one at a time)."""
         nodes = self._loop_nodes() if nodes is None else nodes
         if nodes:
-            self.publisher.publish(Clock(stamp), lambda c: c.endpoint_id in nodes)
+            self._publish(Clock(stamp), lambda c: c.endpoint_id in nodes)
 
     def flush(self):
         """The latest tick to each watcher that has not had it (call while paused)."""
@@ -111,7 +115,22 @@ class ClockTopic:
                 return True
             return False
 
-        self.publisher.publish(self._latest, share)
+        self._publish(self._latest, share)
+
+    def _publish(self, msg, share=None):
+        """Writes a tick to the subscribers `share` picks (all: None), each after the word
+        on it that lockstep may owe its node."""
+        before = self._before_tick
+        if before is None:
+            self.publisher.publish(msg, share)
+            return
+
+        def share_and_tell(connection):
+            if share is None or share(connection):
+                before(connection)
+                return True
+            return False
+        self.publisher.publish(msg, share_and_tell)
 
     def _slot(self, sim_time):
         """The number of the clock period `sim_time` [s] falls in (a millionth of a period's

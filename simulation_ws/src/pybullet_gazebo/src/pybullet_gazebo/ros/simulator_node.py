@@ -52,6 +52,7 @@ from pybullet_gazebo.ros.lockstep.node_processes import MASTER, NodeProcesses
 from pybullet_gazebo.ros.lockstep.own_receivers import OwnReceivers
 from pybullet_gazebo.ros.lockstep.board import Board
 from pybullet_gazebo.ros.lockstep.service_providers import ServiceProviders
+from pybullet_gazebo.ros.lockstep.tick_word import TickWord
 from pybullet_gazebo.ros.pacing import RealTimePacer
 from pybullet_gazebo.ros.state_topics import StateTopics
 from pybullet_gazebo.ros.watch_rate import topic_limit
@@ -86,7 +87,7 @@ class SimulatorNode:
         self.pacer = RealTimePacer(self.real_time_factor, self.world.sim_time)
         self._node_processes = NodeProcesses(rospy.get_name())
         self._busy_loops = set()            # lockstep: threads taken for busy loops (named)
-        self.board = self._report_sub = self.inbox = None
+        self.board = self._report_sub = self.inbox = self.tick_word = None
         if params.lockstep:
             # the main thread reads the reports and commands it waits for (inbox.py)
             self.inbox = lockstep_inbox.install(lockstep_inbox.Inbox(
@@ -103,6 +104,9 @@ class SimulatorNode:
                                own_outbound=rospy_hooks.outbound_connections,
                                inbox=self.inbox)
             own.on_change = self.board.notify
+            # a lone loop node's tick goes out with its readings and the word on what it
+            # must follow (lockstep/tick_word.py)
+            self.tick_word = TickWord(rospy.get_name(), own, self.board)
             # no Nagle on the reports: a report held back for the last one's ACK would hold
             # the simulation for the receiver's delayed ACK
             self._report_sub = rospy.Subscriber(REPORT_TOPIC, LockstepReport, self._on_report,
@@ -138,8 +142,10 @@ class SimulatorNode:
         self._last_clock_step = 0
         self._model_states_every = self._steps_per_period(params.model_states_rate)
 
-        self.clock_pub = ClockTopic(params.pub_clock_frequency, params.watch_rate,
-                                    self._loop_nodes) if params.use_sim_time else None
+        self.clock_pub = ClockTopic(
+            params.pub_clock_frequency, params.watch_rate, self._loop_nodes,
+            before_tick=self.tick_word.before_tick if self.tick_word is not None else None) \
+            if params.use_sim_time else None
         self.state_topics = StateTopics(self.world, topic_limit(params.watch_rate,
                                                                 params.model_states_rate))
         self.contacts_pub = rospy.Publisher("~contacts", ContactsState, queue_size=100,
@@ -377,6 +383,24 @@ class SimulatorNode:
             self._loop_clock = self._owed = None
         return sent
 
+    def _tick_goes_with_readings(self):
+        """Whether the owed tick may go out now, right after the readings: its only loop node
+        holds its ticks for the word on them (lockstep/tick_word.py), so the tick is set only
+        once the readings are taken in; no report of the readings is waited for."""
+        # word on the ticks spares a round trip only when one node is owed each tick: with
+        # several, each gets its tick once the one before is done with its own. A node that
+        # said it only watches (a recorder, the benchmark's listener) is owed nothing.
+        names = self._watched_names - self.board.watchers()
+        if len(names) != 1 or self.lockstep.watching or self._leaving:
+            self.tick_word.offer(())
+            return False
+        node, = names
+        if node not in self.lockstep.reporting:
+            self.tick_word.offer(())
+            return False
+        self.tick_word.offer(names)
+        return self.tick_word.holding(node)
+
     def _watch_loop_nodes(self):
         """Lockstep waits for the loop nodes: by their reports when they send them (the
         handshake), by the /proc watch of their processes otherwise, and not at all for a
@@ -512,6 +536,9 @@ class SimulatorNode:
             bindings = self._bindings.get(reading.robot.name)
             if bindings is not None and bindings.publish(reading, stamp):
                 scans += 1
+        if self._loop_clock is not None and self._tick_goes_with_readings():
+            self._hand_on_tick()
+            self.lockstep.stats.ticks_with_word += 1
         if contacts_changed:
             self._last_touching = touching
             self._publish_contacts(touching, stamp)

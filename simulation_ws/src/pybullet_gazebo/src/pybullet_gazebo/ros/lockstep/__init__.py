@@ -2,7 +2,8 @@
 what it would see at real time (docs/lockstep.md).
 
 Controller side: tracker.py (is this process done, what has it taken in and written out),
-rospy_hooks.py (rospy fed to the tracker, the reports sent), autoload.py (loads the hooks in
+rospy_hooks.py (rospy fed to the tracker, the reports sent), tick_hold.py (a /clock tick set
+only once the readings sent before it are taken in), autoload.py (loads the hooks in
 every Python process of the project's environment that imports rospy).
 Simulator side: board.py (the latest report of each controller, and whether they are all done
 with what the simulator sent them), gate.py (the loop steps on only once they are), inbox.py
@@ -12,3 +13,4 @@ own_receivers.py (the simulator's own reading threads) and node_processes.py (wh
 is which node).
 """
 REPORT_TOPIC = "/lockstep/report"
+EXPECT_TOPIC = "/lockstep/expect"      # the simulator's word on the /clock ticks it sends

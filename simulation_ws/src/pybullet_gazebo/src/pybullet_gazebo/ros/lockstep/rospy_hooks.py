@@ -12,7 +12,8 @@ install() wraps, in the rospy module of this process:
   threading.Condition.wait, notify   a thread handed work by another (queue.Queue, Event)
   ServiceProxy.call                  a service call in flight; its answer read
   ServiceImpl._handle_request        a service handler running
-  rospy.init_node                    opens the report publisher
+  rospy.init_node                    opens the report publisher, and subscribes to the
+                                     simulator's word on the /clock ticks (tick_hold.py)
 A process whose rospy is wrapped behaves as before: the wrappers count and return what rospy
 returns. Nothing is sent until the simulator subscribes to /lockstep/report, which it does
 only in lockstep.
@@ -27,12 +28,14 @@ import threading
 import time
 import weakref
 
-from pybullet_gazebo.ros.lockstep import REPORT_TOPIC
+from pybullet_gazebo.ros.lockstep import EXPECT_TOPIC, REPORT_TOPIC
+from pybullet_gazebo.ros.lockstep.tick_hold import HOLD, TickHold
 from pybullet_gazebo.ros.lockstep.tracker import Tracker
 
 NOT_COUNTED = {"/rosout", REPORT_TOPIC}     # topics no controller acts on
 
 TRACKER = None                              # this process's Tracker, once installed
+TICK_HOLD = None                            # ... and its TickHold (controllers only)
 _publisher = None
 _reports = True                             # False in the simulator: it counts, never reports
 
@@ -40,7 +43,7 @@ _reports = True                             # False in the simulator: it counts,
 def install(report=True):
     """Wraps this process's rospy (once) and returns its Tracker. `report` false: count
     only, never report (the simulator itself)."""
-    global TRACKER, _reports
+    global TRACKER, TICK_HOLD, _reports
     if not report:
         _reports = False
     if TRACKER is not None:
@@ -58,6 +61,8 @@ def install(report=True):
 
     tracker = TRACKER = Tracker(send=_send, reporting=_reporting if report else lambda: False)
     tracker.counting_only = not report
+    hold = TICK_HOLD = TickHold(tracker.counts_taken)
+    tracker.on_change = hold.taken_changed      # (the simulator sets its own)
     get_ident = threading.get_ident
     in_callback = threading.local()      # .depth: callbacks and handlers this thread is in
     waiting = weakref.WeakSet()          # queued connections with messages not yet written
@@ -76,6 +81,7 @@ def install(report=True):
         _publisher = None
         waiting.clear()
         tracker.start_over()
+        hold.start_over()
         tracker._changed._lockstep_untracked = True
     os.register_at_fork(after_in_child=after_fork)
 
@@ -88,13 +94,26 @@ def install(report=True):
             return receive_callback(self, msgs, connection)
         tracker.callback_started()
         in_callback.depth = getattr(in_callback, "depth", 0) + 1
+        port, publisher = _local_port(connection), connection.callerid_pub
         try:
+            if topic == "/clock" and hold.active():
+                # each tick set once the readings sent before it are taken in (tick_hold.py)
+                before = tracker.count_taken(topic, publisher, port)
+                for number, msg in enumerate(msgs, before + 1):
+                    hold.wait_for_word(number, publisher, port, time.monotonic)
+                    receive_callback(self, [msg], connection)
+                return None
+            if topic == EXPECT_TOPIC:
+                in_callback.connection = connection     # (the word's, for its liveness)
             return receive_callback(self, msgs, connection)
         finally:
             in_callback.depth -= 1
             now = rospy.rostime.get_rostime().to_nsec() if topic == "/clock" else None
-            tracker.callback_ended(topic, connection.callerid_pub, _local_port(connection),
-                                   len(msgs), now)
+            # a word on the ticks is news only when it asks to hold them: its answer (the
+            # count, in the next report) is what the simulator waits for before it relies on
+            # the hold; a tick's word needs no report of its own
+            news = topic != EXPECT_TOPIC or any(m.kind == HOLD for m in msgs)
+            tracker.callback_ended(topic, publisher, port, len(msgs), now, news)
     rospy.topics._SubscriberImpl.receive_callback = counted_receive_callback
 
     read_messages = tcpros_pubsub.TCPROSSub.read_messages
@@ -282,6 +301,7 @@ def install(report=True):
         if _reports:
             try:
                 _open_publisher()
+                _subscribe_word(hold, in_callback)
             except ImportError:         # lockstep_msgs not built: the process is not heard
                 pass
         return result
@@ -374,6 +394,9 @@ def _peer_port(connection):
     return _port(connection, "getpeername")
 
 
+peer_port = _peer_port           # (for the simulator's word on the ticks, tick_word.py)
+
+
 def _port(connection, end):
     """The TCP port of the connection's subscriber end, kept once known. 0 while it has no
     socket yet (rospy lists a subscriber's connection before it connects) and not kept: a 0
@@ -411,6 +434,20 @@ def _open_publisher():
         warnings.simplefilter("ignore", SyntaxWarning)
         _publisher = rospy.Publisher(REPORT_TOPIC, LockstepReport, queue_size=None,
                                      subscriber_listener=_OnConnect())
+
+
+def _subscribe_word(hold, in_callback):
+    """The simulator's word on this process's /clock ticks (tick_hold.py), read in a thread of
+    rospy's; nothing comes unless a simulator in lockstep decides to hold the ticks."""
+    import rospy
+    from lockstep_msgs.msg import LockstepExpect
+
+    def heard(msg):
+        hold.heard(msg.kind, msg.clock_port, msg.clock_count,
+                   {(t, port): n for t, port, n in zip(msg.topics, msg.ports, msg.counts)},
+                   msg._connection_header.get("callerid"), in_callback.connection)
+
+    rospy.Subscriber(EXPECT_TOPIC, LockstepExpect, heard, queue_size=None, tcp_nodelay=True)
 
 
 def _room_for(connection, size):
