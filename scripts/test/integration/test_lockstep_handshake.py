@@ -63,7 +63,7 @@ def ticks_and_scans(log_dir):
 @pytest.mark.parametrize("busy_cores", [0, 2])
 def test_a_lone_loop_gets_its_tick_with_the_readings_and_acts_on_the_scan_of_its_time(
         tmp_path, busy_cores):
-    """A lone loop node's tick goes out with the readings and the word on them
+    """A lone loop node's tick goes out with the readings, with word of what it follows
     (lockstep/tick_word.py): its process sets the tick only once the scan of that time has
     gone through its callback, so every turn of a rospy.Rate(20) loop sees the scan stamped
     with its own sim time, with both cores busy too. With `rostopic hz` reading the scan
@@ -73,13 +73,13 @@ def test_a_lone_loop_gets_its_tick_with_the_readings_and_acts_on_the_scan_of_its
     assert len(notes) > 100, notes
     late = [(now, scan) for now, scan in notes[1:] if now != scan]
     assert not late, "turns that did not see the scan of their time: %s" % late[:5]
-    assert "with the readings and the word on them" in lockstep_line(lone)
+    assert "sent with the readings" in lockstep_line(lone)
     if busy_cores:
         return
     beside = run(tmp_path / "beside", "--controller", "ticks", "--scan-reader")
     assert lone["track_sha256"] == beside["track_sha256"], (lone["m2wr"], beside["m2wr"])
     line = lockstep_line(beside)
-    assert "with the readings and the word" not in line and "0 time-outs" in line, line
+    assert "sent with the readings" not in line and "0 time-outs" in line, line
 
 
 def test_a_controller_in_another_pid_namespace_is_waited_for_exactly(

@@ -44,13 +44,13 @@ class _Watcher:
 
 class ClockTopic:
     def __init__(self, clock_rate, watch_rate, loop_nodes, clock=time.monotonic,
-                 before_tick=None):
+                 sent_elsewhere=None):
         """`clock_rate` [Hz sim]: ~pub_clock_frequency; `watch_rate` [Hz wall]: ~watch_rate;
-        `loop_nodes()`: the names of the loop nodes (see above), now; `before_tick(connection)`:
-        called before each tick is written to a subscriber (lockstep's word on it,
-        lockstep/tick_word.py)."""
+        `loop_nodes()`: the names of the loop nodes (see above), now;
+        `sent_elsewhere(connection, stamp)`: True when lockstep sent a subscriber's tick
+        another way (with word of what it follows, lockstep/tick_word.py)."""
         self.publisher = DirectPublisher("/clock", Clock)
-        self._before_tick = before_tick
+        self._sent_elsewhere = sent_elsewhere
         self._period = 1.0 / clock_rate if clock_rate > 0 else 0.0      # [s] sim
         self._wall_limit = topic_limit(watch_rate, clock_rate)         # [Hz] wall
         self._limited = watch_rate > 0
@@ -118,19 +118,17 @@ class ClockTopic:
         self._publish(self._latest, share)
 
     def _publish(self, msg, share=None):
-        """Writes a tick to the subscribers `share` picks (all: None), each after the word
-        on it that lockstep may owe its node."""
-        before = self._before_tick
-        if before is None:
+        """Writes a tick to the subscribers `share` picks (all: None), but for those whose
+        tick lockstep sends another way."""
+        elsewhere = self._sent_elsewhere
+        if elsewhere is None:
             self.publisher.publish(msg, share)
             return
 
-        def share_and_tell(connection):
-            if share is None or share(connection):
-                before(connection)
-                return True
-            return False
-        self.publisher.publish(msg, share_and_tell)
+        def share_here(connection):
+            return (share is None or share(connection)) and \
+                not elsewhere(connection, msg.clock)
+        self.publisher.publish(msg, share_here)
 
     def _slot(self, sim_time):
         """The number of the clock period `sim_time` [s] falls in (a millionth of a period's

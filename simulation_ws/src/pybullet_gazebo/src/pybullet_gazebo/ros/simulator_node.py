@@ -104,9 +104,9 @@ class SimulatorNode:
                                own_outbound=rospy_hooks.outbound_connections,
                                inbox=self.inbox)
             own.on_change = self.board.notify
-            # a lone loop node's tick goes out with its readings and the word on what it
-            # must follow (lockstep/tick_word.py)
-            self.tick_word = TickWord(rospy.get_name(), own, self.board)
+            # a lone loop node's tick goes out with its readings and word of what it must
+            # follow (lockstep/tick_word.py)
+            self.tick_word = TickWord(rospy.get_name(), own)
             # no Nagle on the reports: a report held back for the last one's ACK would hold
             # the simulation for the receiver's delayed ACK
             self._report_sub = rospy.Subscriber(REPORT_TOPIC, LockstepReport, self._on_report,
@@ -144,7 +144,7 @@ class SimulatorNode:
 
         self.clock_pub = ClockTopic(
             params.pub_clock_frequency, params.watch_rate, self._loop_nodes,
-            before_tick=self.tick_word.before_tick if self.tick_word is not None else None) \
+            sent_elsewhere=self.tick_word.tick if self.tick_word is not None else None) \
             if params.use_sim_time else None
         self.state_topics = StateTopics(self.world, topic_limit(params.watch_rate,
                                                                 params.model_states_rate))
@@ -385,8 +385,8 @@ class SimulatorNode:
 
     def _tick_goes_with_readings(self):
         """Whether the owed tick may go out now, right after the readings: its only loop node
-        holds its ticks for the word on them (lockstep/tick_word.py), so the tick is set only
-        once the readings are taken in; no report of the readings is waited for."""
+        gets its ticks with word of what they follow (lockstep/tick_word.py), so the tick is
+        set only once the readings are taken in; no report of the readings is waited for."""
         # word on the ticks spares a round trip only when one node is owed each tick: with
         # several, each gets its tick once the one before is done with its own. A node that
         # said it only watches (a recorder, the benchmark's listener) is owed nothing.

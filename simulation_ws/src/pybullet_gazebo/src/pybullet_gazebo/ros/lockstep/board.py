@@ -224,9 +224,9 @@ class Board:
         # (the next one that does is waited for, with every tick before it)
         skip_clock = report.next_wake == 0 or report.next_wake > self.clock_sent.get(node, 0)
         for (topic, peer, port), count in written_own.items():
-            # (the word on a tick is taken in with the tick, which is waited for as such)
+            # (ticks also go with word of what they follow, lockstep/tick_word.py)
             if peer == node and report.taken.get((topic, me, port), 0) < count \
-                    and not (skip_clock and topic == CLOCK) and topic != EXPECT_TOPIC:
+                    and not (skip_clock and topic in (CLOCK, EXPECT_TOPIC)):
                 return node, "%s not taken in: %d of %d" % (
                     topic, report.taken.get((topic, me, port), 0), count)
         for (topic, peer, port), count in report.written.items():

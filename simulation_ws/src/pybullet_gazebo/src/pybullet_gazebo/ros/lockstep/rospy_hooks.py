@@ -29,7 +29,7 @@ import time
 import weakref
 
 from pybullet_gazebo.ros.lockstep import EXPECT_TOPIC, REPORT_TOPIC
-from pybullet_gazebo.ros.lockstep.tick_hold import HOLD, TickHold
+from pybullet_gazebo.ros.lockstep.tick_hold import HOLD, TICK, TickHold
 from pybullet_gazebo.ros.lockstep.tracker import Tracker
 
 NOT_COUNTED = {"/rosout", REPORT_TOPIC}     # topics no controller acts on
@@ -94,26 +94,21 @@ def install(report=True):
             return receive_callback(self, msgs, connection)
         tracker.callback_started()
         in_callback.depth = getattr(in_callback, "depth", 0) + 1
-        port, publisher = _local_port(connection), connection.callerid_pub
         try:
-            if topic == "/clock" and hold.active():
-                # each tick set once the readings sent before it are taken in (tick_hold.py)
-                before = tracker.count_taken(topic, publisher, port)
-                for number, msg in enumerate(msgs, before + 1):
-                    hold.wait_for_word(number, publisher, port, time.monotonic)
-                    receive_callback(self, [msg], connection)
-                return None
-            if topic == EXPECT_TOPIC:
-                in_callback.connection = connection     # (the word's, for its liveness)
             return receive_callback(self, msgs, connection)
         finally:
             in_callback.depth -= 1
-            now = rospy.rostime.get_rostime().to_nsec() if topic == "/clock" else None
-            # a word on the ticks is news only when it asks to hold them: its answer (the
-            # count, in the next report) is what the simulator waits for before it relies on
-            # the hold; a tick's word needs no report of its own
-            news = topic != EXPECT_TOPIC or any(m.kind == HOLD for m in msgs)
-            tracker.callback_ended(topic, publisher, port, len(msgs), now, news)
+            now, news = None, None
+            if topic == "/clock":
+                now = rospy.rostime.get_rostime().to_nsec()
+            elif topic == EXPECT_TOPIC:
+                # a tick sent with word (tick_hold.py) is news when it wakes a sleeper, as a
+                # /clock tick; a HOLD always (the simulator counts on it from then on)
+                if any(m.kind == TICK for m in msgs):
+                    now = rospy.rostime.get_rostime().to_nsec()
+                news = any(m.kind == HOLD for m in msgs)
+            tracker.callback_ended(topic, connection.callerid_pub, _local_port(connection),
+                                   len(msgs), now, news)
     rospy.topics._SubscriberImpl.receive_callback = counted_receive_callback
 
     read_messages = tcpros_pubsub.TCPROSSub.read_messages
@@ -301,7 +296,7 @@ def install(report=True):
         if _reports:
             try:
                 _open_publisher()
-                _subscribe_word(hold, in_callback)
+                _subscribe_ticks(hold)
             except ImportError:         # lockstep_msgs not built: the process is not heard
                 pass
         return result
@@ -436,16 +431,22 @@ def _open_publisher():
                                      subscriber_listener=_OnConnect())
 
 
-def _subscribe_word(hold, in_callback):
-    """The simulator's word on this process's /clock ticks (tick_hold.py), read in a thread of
-    rospy's; nothing comes unless a simulator in lockstep decides to hold the ticks."""
+def _subscribe_ticks(hold):
+    """The ticks a simulator in lockstep sends this process with word of what they follow
+    (tick_hold.py), read in a thread of rospy's; nothing comes unless one decides to."""
     import rospy
+    import rospy.rostime
     from lockstep_msgs.msg import LockstepExpect
 
     def heard(msg):
-        hold.heard(msg.kind, msg.clock_port, msg.clock_count,
-                   {(t, port): n for t, port, n in zip(msg.topics, msg.ports, msg.counts)},
-                   msg._connection_header.get("callerid"), in_callback.connection)
+        simulator = msg._connection_header.get("callerid")
+        if msg.kind == HOLD:
+            hold.heard_hold(simulator, msg.clock_port, msg.clock_count)
+        elif msg.kind == TICK:
+            hold.wait(simulator, {(t, port): n for t, port, n in zip(msg.topics, msg.ports,
+                                                                       msg.counts)},
+                      time.monotonic)
+            rospy.rostime._set_rostime(msg.clock)      # what rospy's /clock subscriber does
 
     rospy.Subscriber(EXPECT_TOPIC, LockstepExpect, heard, queue_size=None, tcp_nodelay=True)
 

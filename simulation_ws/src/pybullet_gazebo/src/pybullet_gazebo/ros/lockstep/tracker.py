@@ -78,16 +78,18 @@ class Tracker:
         with self._lock:
             self._running += 1
 
-    def callback_ended(self, topic, peer, port, count, now=None, news=True):
+    def callback_ended(self, topic, peer, port, count, now=None, news=None):
         """`count` messages of (topic, peer, port) went through every callback; `now` [ns sim]:
-        the time a /clock message just set (wakes the sleepers it reaches); `news` false: the
-        simulator waits for no report of these (the word on a tick, tick_hold.py)."""
+        the time a tick just set (wakes the sleepers it reaches); `news`: whether the
+        simulator waits for word of these even when they wake no sleeper (default: unless
+        they set the time)."""
         with self._lock:
             key = (topic, peer, port)
             self.taken[key] = self.taken.get(key, 0) + count
-            # a /clock tick that wakes no sleeper is no news: the simulator does not wait
-            # for such a tick (board.py), so it needs no report of it
-            news = news and (now is None or self._wake_sleepers(now))
+            # a tick that wakes no sleeper is no news: the simulator does not wait for such a
+            # tick (board.py), so it needs no report of it
+            woke = now is not None and self._wake_sleepers(now)
+            news = woke or (now is None if news is None else news)
             self._running -= 1
             self._wake_pollers(news)
         self._after_change()
@@ -270,11 +272,6 @@ class Tracker:
         with self._lock:
             answered, self.answered = self.answered, []
             return answered
-
-    def count_taken(self, topic, peer, port):
-        """Messages of one connection taken in so far, those dropped unread included."""
-        with self._lock:
-            return self.taken.get((topic, peer, port), 0) + self._dropped.get((topic, port), 0)
 
     def counts_taken(self):
         """A copy of the messages taken in per connection, dropped ones included."""
