@@ -66,9 +66,12 @@ def test_a_lone_loop_gets_its_tick_with_the_readings_and_acts_on_the_scan_of_its
     """A lone loop node's tick goes out with the readings, with word of what it follows
     (lockstep/tick_word.py): its process sets the tick only once the scan of that time has
     gone through its callback, so every turn of a rospy.Rate(20) loop sees the scan stamped
-    with its own sim time, with both cores busy too. With `rostopic hz` reading the scan
+    with its own sim time, with both cores busy too, and a neighbour sending ticks of its
+    own making changes nothing. With `rostopic hz` reading the scan
     beside it, each tick waits for the readings' report instead: the same track, to the bit."""
-    lone = run(tmp_path / "lone", "--controller", "ticks", "--busy-cores", str(busy_cores))
+    # bad_neighbour.py's ticks: ticks of its own making, which must change nothing
+    lone = run(tmp_path / "lone", "--controller", "ticks", "--busy-cores", str(busy_cores),
+               "ticks")
     notes = ticks_and_scans(tmp_path / "lone")
     assert len(notes) > 100, notes
     late = [(now, scan) for now, scan in notes[1:] if now != scan]

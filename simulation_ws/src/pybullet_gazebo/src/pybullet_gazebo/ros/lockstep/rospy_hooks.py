@@ -106,7 +106,8 @@ def install(report=True):
                 # /clock tick; a HOLD always (the simulator counts on it from then on)
                 if any(m.kind == TICK for m in msgs):
                     now = rospy.rostime.get_rostime().to_nsec()
-                news = any(m.kind == HOLD for m in msgs)
+                news = any(m.kind == HOLD for m in msgs) and \
+                    connection.callerid_pub in _clock_publishers()
             tracker.callback_ended(topic, connection.callerid_pub, _local_port(connection),
                                    len(msgs), now, news)
     rospy.topics._SubscriberImpl.receive_callback = counted_receive_callback
@@ -440,6 +441,8 @@ def _subscribe_ticks(hold):
 
     def heard(msg):
         simulator = msg._connection_header.get("callerid")
+        if simulator not in _clock_publishers():
+            return              # only the node that sends this process /clock sets its time
         if msg.kind == HOLD:
             hold.heard_hold(simulator, msg.clock_port, msg.clock_count)
         elif msg.kind == TICK:
@@ -449,6 +452,13 @@ def _subscribe_ticks(hold):
             rospy.rostime._set_rostime(msg.clock)      # what rospy's /clock subscriber does
 
     rospy.Subscriber(EXPECT_TOPIC, LockstepExpect, heard, queue_size=None, tcp_nodelay=True)
+
+
+def _clock_publishers():
+    """The nodes this process's /clock subscriber is connected to (the simulator)."""
+    from rospy.impl.registration import get_topic_manager
+    impl = get_topic_manager().get_subscriber_impl("/clock")
+    return {c.callerid_pub for c in list(impl.connections)} if impl is not None else set()
 
 
 def _room_for(connection, size):
