@@ -12,8 +12,8 @@ install() wraps, in the rospy module of this process:
   threading.Condition.wait, notify   a thread handed work by another (queue.Queue, Event)
   ServiceProxy.call                  a service call in flight; its answer read
   ServiceImpl._handle_request        a service handler running
-  rospy.init_node                    opens the report publisher, and subscribes to the
-                                     simulator's word on the /clock ticks (tick_hold.py)
+  rospy.init_node                    opens the report publisher, and subscribes to the ticks
+                                     a simulator may send with the readings (tick_hold.py)
 A process whose rospy is wrapped behaves as before: the wrappers count and return what rospy
 returns. Nothing is sent until the simulator subscribes to /lockstep/report, which it does
 only in lockstep.
@@ -390,7 +390,7 @@ def _peer_port(connection):
     return _port(connection, "getpeername")
 
 
-peer_port = _peer_port           # (for the simulator's word on the ticks, tick_word.py)
+peer_port = _peer_port           # (for tick_word.py: ticks sent with the readings)
 
 
 def _port(connection, end):
