@@ -9,7 +9,7 @@ from lockstep_msgs.msg import LockstepExpect
 from pybullet_gazebo.ros.lockstep import EXPECT_TOPIC
 from pybullet_gazebo.ros.lockstep.tick_word import TickWord
 
-SIM, NODE, SCAN = "/gazebo", "/follow_wall", "/m2wr/laser/scan"
+NODE, SCAN = "/follow_wall", "/m2wr/laser/scan"
 
 
 class Connection:
@@ -51,7 +51,7 @@ def setup():
     tracker = Tracker()
     publisher = Publisher(tracker)
     live = set()
-    word = TickWord(SIM, tracker, publisher=publisher, live_outbound=lambda: live,
+    word = TickWord(tracker, publisher=publisher, live_outbound=lambda: live,
                     port_of=lambda connection: connection.port)
     return word, tracker, publisher, live
 

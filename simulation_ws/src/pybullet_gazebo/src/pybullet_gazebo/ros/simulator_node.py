@@ -106,7 +106,7 @@ class SimulatorNode:
             own.on_change = self.board.notify
             # a lone loop node's tick goes out with its readings and word of what it must
             # follow (lockstep/tick_word.py)
-            self.tick_word = TickWord(rospy.get_name(), own)
+            self.tick_word = TickWord(own)
             # no Nagle on the reports: a report held back for the last one's ACK would hold
             # the simulation for the receiver's delayed ACK
             self._report_sub = rospy.Subscriber(REPORT_TOPIC, LockstepReport, self._on_report,
@@ -387,17 +387,15 @@ class SimulatorNode:
         """Whether the owed tick may go out now, right after the readings: its only loop node
         gets its ticks with word of what they follow (lockstep/tick_word.py), so the tick is
         set only once the readings are taken in; no report of the readings is waited for."""
-        # word on the ticks spares a round trip only when one node is owed each tick: with
-        # several, each gets its tick once the one before is done with its own. A node that
-        # said it only watches (a recorder, the benchmark's listener) is owed nothing.
+        # a tick sent with the readings spares a round trip only when one node is owed each
+        # tick: with several, each gets its tick once the one before is done with its own. A
+        # node that said it only watches (a recorder, the benchmark's listener) is owed nothing.
         names = self._watched_names - self.board.watchers()
-        if len(names) != 1 or self.lockstep.watching or self._leaving:
+        if len(names) != 1 or not names <= self.lockstep.reporting or self.lockstep.watching \
+                or self._leaving:
             self.tick_word.offer(())
             return False
         node, = names
-        if node not in self.lockstep.reporting:
-            self.tick_word.offer(())
-            return False
         # only a node with a sleeper (a rospy.Rate loop, a Timer) needs its ticks after the
         # readings; one that answers in its callbacks (obstacle_avoidance.py) would only pay
         # for a word per tick
@@ -542,7 +540,7 @@ class SimulatorNode:
                 scans += 1
         if self._loop_clock is not None and self._tick_goes_with_readings():
             self._hand_on_tick()
-            self.lockstep.stats.ticks_with_word += 1
+            self.lockstep.stats.ticks_with_readings += 1
         if contacts_changed:
             self._last_touching = touching
             self._publish_contacts(touching, stamp)

@@ -14,4 +14,5 @@ own_receivers.py (the simulator's own reading threads) and node_processes.py (wh
 is which node).
 """
 REPORT_TOPIC = "/lockstep/report"
+CLOCK_TOPIC = "/clock"
 EXPECT_TOPIC = "/lockstep/expect"      # a lone loop's ticks, with the counts they follow

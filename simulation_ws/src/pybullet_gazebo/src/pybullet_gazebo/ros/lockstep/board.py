@@ -22,9 +22,8 @@ import collections
 import threading
 import time
 
-from pybullet_gazebo.ros.lockstep import EXPECT_TOPIC
+from pybullet_gazebo.ros.lockstep import CLOCK_TOPIC as CLOCK, EXPECT_TOPIC
 
-CLOCK = "/clock"
 KEEP_CALLS = 4096          # unmatched service-call records kept (a client or server that died)
 KEEP_SEQS = 4096           # report numbers remembered per process, to know one sent twice
 

@@ -46,7 +46,7 @@ class LockstepStats:
         self.waited_for = {}        # who was at work when a wait began -> [s] wall waited
         self.ticks_while_stepping = 0   # /clock ticks handed on while physics ran on
         self.ticks = 0                  # /clock ticks handed on to a loop node in all
-        self.ticks_with_word = 0        # ... sent with the readings (tick_word.py)
+        self.ticks_with_readings = 0    # ... sent with the readings (tick_word.py)
         self.handshake = set()          # controllers waited for by their reports
         self.watched = set()            # ... and by the /proc watch (no reports)
 
@@ -56,8 +56,8 @@ class LockstepStats:
         if self.ticks:
             text += ", %d of %d /clock ticks to a loop node handed on while physics ran" % (
                 self.ticks_while_stepping, self.ticks)
-            if self.ticks_with_word:
-                text += " and %d sent with the readings" % self.ticks_with_word
+            if self.ticks_with_readings:
+                text += " and %d sent with the readings" % self.ticks_with_readings
         if self.stepped_past:
             text += " (still at work: %s)" % ", ".join(
                 "%s %d x" % item for item in sorted(self.stepped_past.items()))

@@ -28,7 +28,7 @@ import threading
 import time
 import weakref
 
-from pybullet_gazebo.ros.lockstep import EXPECT_TOPIC, REPORT_TOPIC
+from pybullet_gazebo.ros.lockstep import CLOCK_TOPIC, EXPECT_TOPIC, REPORT_TOPIC
 from pybullet_gazebo.ros.lockstep.tick_hold import HOLD, TICK, TickHold
 from pybullet_gazebo.ros.lockstep.tracker import Tracker
 
@@ -99,7 +99,7 @@ def install(report=True):
         finally:
             in_callback.depth -= 1
             now, news = None, None
-            if topic == "/clock":
+            if topic == CLOCK_TOPIC:
                 now = rospy.rostime.get_rostime().to_nsec()
             elif topic == EXPECT_TOPIC:
                 # a tick sent with word (tick_hold.py) is news when it wakes a sleeper, as a
@@ -457,7 +457,7 @@ def _subscribe_ticks(hold):
 def _clock_publishers():
     """The nodes this process's /clock subscriber is connected to (the simulator)."""
     from rospy.impl.registration import get_topic_manager
-    impl = get_topic_manager().get_subscriber_impl("/clock")
+    impl = get_topic_manager().get_subscriber_impl(CLOCK_TOPIC)
     return {c.callerid_pub for c in list(impl.connections)} if impl is not None else set()
 
 

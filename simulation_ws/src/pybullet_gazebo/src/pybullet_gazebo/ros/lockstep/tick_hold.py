@@ -19,8 +19,9 @@ within HOLD_CAP (a simulator that went away) is set anyway and counted in `late`
 """
 import threading
 
+from pybullet_gazebo.ros.lockstep import CLOCK_TOPIC as CLOCK
+
 HOLD, TICK = 1, 2           # lockstep_msgs/LockstepExpect's kinds
-CLOCK = "/clock"
 HOLD_CAP = 1.0              # [s] wall: the longest a tick is held for counts that do not come
 
 

@@ -16,14 +16,13 @@ are then. `holding(node)`: its ticks go here, so one may go out with the reading
 from lockstep_msgs.msg import LockstepExpect
 
 from pybullet_gazebo.ros.direct_publisher import DirectPublisher
-from pybullet_gazebo.ros.lockstep import EXPECT_TOPIC, rospy_hooks
+from pybullet_gazebo.ros.lockstep import CLOCK_TOPIC as CLOCK, EXPECT_TOPIC, rospy_hooks
 
-CLOCK = "/clock"
 _NOT_NAMED = (CLOCK, EXPECT_TOPIC)       # topics a tick's counts leave out
 
 
 class TickWord:
-    def __init__(self, own_name, tracker, publisher=None,
+    def __init__(self, tracker, publisher=None,
                  live_outbound=rospy_hooks.outbound_connections, port_of=rospy_hooks.peer_port):
         """`tracker`: the simulator's own Tracker (what it wrote to whom); `publisher`: of the
         ticks (a DirectPublisher on /lockstep/expect by default); `live_outbound()`:
@@ -31,7 +30,6 @@ class TickWord:
         `port_of(connection)`: the port of its subscriber's end."""
         self.publisher = publisher or DirectPublisher(EXPECT_TOPIC, LockstepExpect)
         self.offered = frozenset()          # nodes told HOLD at their next tick
-        self._own = own_name
         self._tracker = tracker
         self._live_outbound = live_outbound
         self._port_of = port_of
@@ -96,6 +94,3 @@ class TickWord:
 
     def _write(self, connection, msg):
         self.publisher.publish(msg, lambda c: c is connection)
-
-    def close(self):
-        self.publisher.publisher.unregister()
