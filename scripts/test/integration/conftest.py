@@ -127,6 +127,9 @@ def check_sane(data, outlines, count):
     assert len(runs) == count and len({r["run_id"] for r in runs}) == count
     for r in runs:
         assert "reason" in r and r["reason"], r
+        # a run that failed has no metrics: its reason says why
+        assert "sim_time_s" in r, "run %s on %s failed: %s" % (
+            r["run_id"], r.get("worker"), r["reason"])
         assert r["sim_time_s"] >= DURATION - 0.1, r["reason"]
         assert r["cmd_vel_messages"] > 0
         # the start is free and the path starts there
