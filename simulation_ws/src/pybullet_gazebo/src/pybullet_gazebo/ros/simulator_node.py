@@ -396,11 +396,7 @@ class SimulatorNode:
             self.tick_word.offer(())
             return False
         node, = names
-        # only a node with a sleeper (a rospy.Rate loop, a Timer) needs its ticks after the
-        # readings; one that answers in its callbacks (obstacle_avoidance.py) would only pay
-        # for a word per tick
-        report = self.board.report_of(node)
-        self.tick_word.offer(names if report is not None and report.next_wake else ())
+        self.tick_word.offer(names)
         return self.tick_word.holding(node)
 
     def _watch_loop_nodes(self):

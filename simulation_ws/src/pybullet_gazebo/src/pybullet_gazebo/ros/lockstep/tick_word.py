@@ -8,8 +8,9 @@ here, with the counts of what the simulator wrote to the process so far, it goes
 readings: the process sets the time once those counts are taken in, and the program sees the
 same readings at the same sim time.
 
-Who: a lone loop node that reports and has a sleeper (`offer`), where it spares the round
-trip. A node is told HOLD once on its connection (`tick`); from then on every tick to its
+Who: a lone loop node that reports (`offer`). One that answers in its callbacks has no loop
+to wake, but its tick sent on /clock would still wait for its report of the readings, and
+physics would go step by step meanwhile. A node is told HOLD once on its connection (`tick`); from then on every tick to its
 process goes here, none on /clock, for as long as the connection lives, whoever the loop nodes
 are then. `holding(node)`: its ticks go here, so one may go out with the readings.
 """
