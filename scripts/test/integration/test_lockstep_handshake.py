@@ -85,6 +85,29 @@ def test_a_lone_loop_gets_its_tick_with_the_readings_and_acts_on_the_scan_of_its
     assert "sent with the readings" not in line and "0 time-outs" in line, line
 
 
+def test_a_callback_that_naps_in_sim_time_is_not_waited_for(tmp_path):
+    """A scan callback that calls rospy.sleep(0.1) every tenth scan (napping_reader.py): the
+    simulator does not wait for it (it would wait for the callback and the callback for its
+    tick: the run stood still until lockstep_timeout at every nap), the nap lasts its 0.1 s
+    of sim time, and the scans that came meanwhile are handled once it is over."""
+    result = run(tmp_path, "--controller", "naps", "--clock-hz", "20")
+    line = lockstep_line(result)
+    assert "0 time-outs" in line and "still at work" not in line, line
+    with open(tmp_path / "naps.txt") as notes:
+        handled = [tuple(map(int, note.split())) for note in notes if note.strip()]
+    # every scan of the run handled in turn, none lost to the naps (20 Hz, SECONDS of sim)
+    stamps = [scan for _, scan in handled]
+    assert stamps == sorted(stamps) and len(stamps) >= 20 * SECONDS - 2, stamps
+    assert all(b - a == 50000000 for a, b in zip(stamps, stamps[1:])), stamps
+    naps = handled[9::10]
+    assert len(naps) >= 14, handled
+    for index in range(9, len(handled) - 1, 10):
+        (napped_at, _), (next_at, _) = handled[index], handled[index + 1]
+        assert next_at >= napped_at + 100000000, (handled[index], handled[index + 1])
+    commands = [s for s in result["summary"] if s.startswith("commands received")]
+    assert commands and int(commands[0].split()[2]) >= len(handled) - 1, result["summary"]
+
+
 def test_a_controller_in_another_pid_namespace_is_waited_for_exactly(
         tmp_path, tutorial_on_an_idle_machine):
     here = tutorial_on_an_idle_machine

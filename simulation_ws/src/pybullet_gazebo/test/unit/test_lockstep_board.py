@@ -233,3 +233,17 @@ def test_a_call_reported_before_the_simulator_noted_its_answer_is_not_waited_for
     noted.append(("/gazebo/spawn_urdf_model", 7, "/tool"))
     assert board.busy({"/tool"}) is None                  # the note matches the word
     assert not board.pending_calls({"/tool"})
+
+
+def test_a_parked_connection_is_not_waited_for_until_a_report_says_it_is_read_again():
+    """A controller asleep in its scan callback parks that connection: the scans written
+    meanwhile wait in its socket, and the simulator does not wait for them."""
+    board, own = make()
+    own.written[("/scan", "/ctl", 5)] = 3
+    board.take("/ctl", 1, 1, taken={("/scan", SIM, 5): 2}, written={},
+               parked=[("/scan", SIM, 5)])
+    assert board.busy({"/ctl"}) is None
+    board.take("/ctl", 1, 2, taken={}, written={})                 # back at work, then done
+    assert board.busy({"/ctl"})[0] == "/ctl"
+    board.take("/ctl", 1, 3, taken={("/scan", SIM, 5): 3}, written={})
+    assert board.busy({"/ctl"}) is None

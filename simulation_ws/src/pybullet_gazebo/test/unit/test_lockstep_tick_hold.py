@@ -71,3 +71,14 @@ def test_a_tick_whose_counts_never_come_is_set_after_the_cap_and_counted(monkeyp
     hold.wait(SIM, {(SCAN, SCAN_PORT): 1}, time.monotonic)
     assert 0.15 < time.monotonic() - start < 1.5
     assert hold.late == 1
+
+
+
+def test_a_tick_does_not_wait_for_messages_behind_a_callback_asleep_in_sim_time():
+    """What comes on a parked connection is read only once a tick wakes its thread: a tick
+    that waited for it would be held to HOLD_CAP, and set late."""
+    hold = TickHold(lambda: {}, lambda: {(SCAN, SIM, SCAN_PORT)})
+    hold.heard_hold(SIM, clock_port=CLOCK_PORT, clock_count=0)
+    started = time.monotonic()
+    hold.wait(SIM, {(SCAN, SCAN_PORT): 2}, time.monotonic)
+    assert hold.late == 0 and time.monotonic() - started < 0.5 * tick_hold.HOLD_CAP

@@ -393,3 +393,25 @@ def test_rospys_own_reconnect_loop_is_not_taken_for_a_busy_loop():
     finally:
         tracker.counting_only = counting_only
         tracker.forget_thread(tid)
+
+
+def test_a_callback_asleep_in_sim_time_has_taken_its_message_in_and_parks_its_connection():
+    """rospy.sleep inside a scan callback: the process is done (the simulator would otherwise
+    wait for the callback, and the callback for its next tick), the scan counts as taken in,
+    and the connection is parked (what comes on it waits until the thread is back)."""
+    tracker, reports = make()
+    tracker.callback_started(tid=3, key=SCAN, count=1)
+    tracker.sleep_started(tid=3, start=1000 * MS, duration=100 * MS)
+    assert tracker.done()
+    assert reports[-1]["taken"] == {SCAN: 1} and reports[-1]["parked"] == [SCAN]
+    assert reports[-1]["next_wake"] == 1100 * MS
+    assert tracker.parked() == {SCAN}
+    tracker.callback_started()
+    tracker.callback_ended(*CLOCK, count=1, now=1100 * MS)            # its wake-up
+    tracker.sleep_ended(tid=3)
+    assert not tracker.done() and tracker.parked() == set()           # back at work
+    tracker.wrote("/cmd_vel", "/gazebo", 40000)
+    tracker.callback_ended(*SCAN, count=1, tid=3)                      # the callback returns
+    assert tracker.done()
+    assert tracker.counts_taken()[SCAN] == 1                           # counted once
+    assert reports[-1]["parked"] == []

@@ -457,7 +457,8 @@ class SimulatorNode:
                                                        msg.out_ports, msg.out_counts)},
             served=list(zip(msg.served_services, msg.served_ports)),
             called=list(zip(msg.called_services, msg.called_ports)), next_wake=msg.next_wake,
-            watcher=msg.watcher)
+            watcher=msg.watcher,
+            parked=list(zip(msg.parked_topics, msg.parked_peers, msg.parked_ports)))
 
     def _note_busy_loop(self, pid, tid):
         """Lockstep took thread `tid` of `pid` for a busy loop: it is not waited for."""

@@ -37,15 +37,18 @@ class NodeReport:
         self.written = {}            # (topic, subscriber, port) -> count
         self.next_wake = 0           # [ns sim] its earliest sleeper's wake-up, 0: none
         self.watcher = False         # it said it only watches: never waited for
+        self.parked = frozenset()    # (topic, publisher, port) read by a thread asleep in a
+                                     # callback: not waited for (tracker.py)
         self._seqs = collections.deque(maxlen=KEEP_SEQS)     # the latest report numbers
         self._seen = set()
 
-    def merge(self, pid, seq, taken, written, next_wake=0, watcher=False):
+    def merge(self, pid, seq, taken, written, next_wake=0, watcher=False, parked=()):
         """Totals only grow: a report older than one already merged changes nothing. False
         for a report already taken (the same process and number): its service calls,
         which are news once, were counted the first time."""
         if pid != self.pid:          # a new process under the node's name: start over
             self.pid, self.seq, self.taken, self.written = pid, 0, {}, {}
+            self.parked = frozenset()
             self._seqs.clear()
             self._seen.clear()
         if seq in self._seen:
@@ -56,6 +59,7 @@ class NodeReport:
         self._seen.add(seq)
         if seq >= self.seq:
             self.next_wake = next_wake
+            self.parked = frozenset(parked)
         self.watcher = self.watcher or watcher
         self.seq = max(self.seq, seq)
         self.reports += 1
@@ -97,11 +101,11 @@ class Board:
 
     # --- what comes in ----------------------------------------------------------------------
     def take(self, node, pid, seq, taken, written, served=(), called=(), next_wake=0,
-             watcher=False):
+             watcher=False, parked=()):
         """A report from `node` (its connection's callerid, never a field of the report)."""
         with self._changed:
             if not self._reports.setdefault(node, NodeReport()).merge(
-                    pid, seq, taken, written, next_wake, watcher):
+                    pid, seq, taken, written, next_wake, watcher, parked):
                 return              # sent twice: a call it names would be waited for again
             for key in served:
                 if self._called.pop(key, None) is None:
@@ -225,7 +229,8 @@ class Board:
         for (topic, peer, port), count in written_own.items():
             # (ticks also go with word of what they follow, lockstep/tick_word.py)
             if peer == node and report.taken.get((topic, me, port), 0) < count \
-                    and not (skip_clock and topic in (CLOCK, EXPECT_TOPIC)):
+                    and not (skip_clock and topic in (CLOCK, EXPECT_TOPIC)) \
+                    and (topic, me, port) not in report.parked:
                 return node, "%s not taken in: %d of %d" % (
                     topic, report.taken.get((topic, me, port), 0), count)
         for (topic, peer, port), count in report.written.items():

@@ -61,7 +61,7 @@ def install(report=True):
 
     tracker = TRACKER = Tracker(send=_send, reporting=_reporting if report else lambda: False)
     tracker.counting_only = not report
-    hold = TICK_HOLD = TickHold(tracker.counts_taken)
+    hold = TICK_HOLD = TickHold(tracker.counts_taken, tracker.parked)
     tracker.on_change = hold.taken_changed      # (the simulator sets its own)
     get_ident = threading.get_ident
     in_callback = threading.local()      # .depth: callbacks and handlers this thread is in
@@ -92,7 +92,8 @@ def install(report=True):
         topic = self.resolved_name
         if topic in NOT_COUNTED:
             return receive_callback(self, msgs, connection)
-        tracker.callback_started()
+        tid, port = get_ident(), _local_port(connection)
+        tracker.callback_started(tid, (topic, connection.callerid_pub, port), len(msgs))
         in_callback.depth = getattr(in_callback, "depth", 0) + 1
         try:
             return receive_callback(self, msgs, connection)
@@ -108,8 +109,8 @@ def install(report=True):
                     now = rospy.rostime.get_rostime().to_nsec()
                 news = any(m.kind == HOLD for m in msgs) and \
                     connection.callerid_pub in _clock_publishers()
-            tracker.callback_ended(topic, connection.callerid_pub, _local_port(connection),
-                                   len(msgs), now, news)
+            tracker.callback_ended(topic, connection.callerid_pub, port, len(msgs), now, news,
+                                   tid)
     rospy.topics._SubscriberImpl.receive_callback = counted_receive_callback
 
     read_messages = tcpros_pubsub.TCPROSSub.read_messages
@@ -529,6 +530,10 @@ def _message(report):
         msg.out_peers.append(key[1])
         msg.out_ports.append(key[2])
         msg.out_counts.append(count)
+    for topic, peer, port in report["parked"]:
+        msg.parked_topics.append(topic)
+        msg.parked_peers.append(peer)
+        msg.parked_ports.append(port)
     for service, port in report["served"]:
         msg.served_services.append(service)
         msg.served_ports.append(port)

@@ -26,10 +26,13 @@ HOLD_CAP = 1.0              # [s] wall: the longest a tick is held for counts th
 
 
 class TickHold:
-    def __init__(self, taken):
+    def __init__(self, taken, parked=lambda: ()):
         """`taken()`: {(topic, publisher, port): messages taken in} of this process now (the
-        Tracker's counts, those its queue_size dropped included)."""
+        Tracker's counts, those its queue_size dropped included); `parked()`: the
+        connections whose reading thread sleeps in a callback until a later sim time (what
+        comes on them is read only once a tick wakes it: not waited for)."""
         self._taken = taken
+        self._parked = parked
         self._changed = threading.Condition()
         self._changed._lockstep_untracked = True      # (its waits are not the program's)
         self._before = {}           # simulator -> {(topic, port): count}: /clock before HOLD
@@ -67,8 +70,9 @@ class TickHold:
     def _reached(self, counts, publisher):
         if not counts:
             return True
-        taken = self._taken()
+        taken, parked = self._taken(), self._parked()
         return all(taken.get((topic, publisher, port), 0) >= count
+                   or (topic, publisher, port) in parked
                    for (topic, port), count in counts.items())
 
     def start_over(self):

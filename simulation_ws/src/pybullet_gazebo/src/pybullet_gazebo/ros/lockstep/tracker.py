@@ -3,7 +3,9 @@ of lockstep's handshake, kept free of rospy so that it can be tested on its own 
 hooks that feed it are in rospy_hooks.py).
 
 A process is done when
-  - no callback of a subscriber, and no service handler, is running;
+  - no callback of a subscriber, and no service handler, is running; a callback whose thread
+    sleeps in rospy.sleep until a later sim time is done with its message, and its
+    connection is parked: what comes on it is read once the thread is back (`parked`);
   - no service call of its own is in flight;
   - no thread is due: a thread that slept in rospy.sleep (a rospy.Rate or rospy.Timer loop)
     is due from the /clock tick that reaches its wake-up time until it sleeps again, or
@@ -52,7 +54,8 @@ class Tracker:
         self._changed = threading.Condition(self._lock)   # pollers wait on it
         self._changed._lockstep_untracked = True          # (its own waits are not news)
         self._waiting = {}                # id(condition) -> [thread ids waiting, in order]
-        self._running = 0                 # callbacks and handlers running
+        self._running = 0                 # callbacks and handlers running (not sleeping)
+        self._in_callback = {}            # thread id -> [[key, count, parked]], innermost last
         self._calls = 0                   # service calls in flight
         self._due = set()                 # thread ids due (see the module docstring)
         self._sleeping = {}               # thread id -> (start, wake, duration) [ns sim]
@@ -74,27 +77,71 @@ class Tracker:
         self.watcher = False
 
     # --- what the hooks say ------------------------------------------------------------
-    def callback_started(self):
+    def callback_started(self, tid=None, key=None, count=0):
+        """Thread `tid` runs the callbacks of `count` messages of `key` (topic, peer, port)."""
         with self._lock:
             self._running += 1
+            if tid is not None:
+                self._in_callback.setdefault(tid, []).append([key, count, False])
 
-    def callback_ended(self, topic, peer, port, count, now=None, news=None):
+    def callback_ended(self, topic, peer, port, count, now=None, news=None, tid=None):
         """`count` messages of (topic, peer, port) went through every callback; `now` [ns sim]:
         the time a tick just set (wakes the sleepers it reaches); `news`: whether the
         simulator waits for word of these even when they wake no sleeper (default: unless
-        they set the time)."""
+        they set the time); `tid`: the thread, as given to callback_started."""
         with self._lock:
-            key = (topic, peer, port)
-            self.taken[key] = self.taken.get(key, 0) + count
-            # a tick that wakes no sleeper is no news: the simulator does not wait for such a
-            # tick (board.py), so it needs no report of it
-            woke = now is not None and self._wake_sleepers(now)
-            news = woke or (now is None if news is None else news)
-            self._running -= 1
-            self._wake_pollers(news)
+            entry = self._callback_left(tid)
+            if entry is not None and entry[2]:
+                # it slept in the callback: taken in then (_park_callbacks); back from that
+                # sleep the thread was due, and now it is back to reading
+                self._due.discard(tid)
+                self._last.pop(tid, None)
+                self._wake_pollers()
+            else:
+                key = (topic, peer, port)
+                self.taken[key] = self.taken.get(key, 0) + count
+                # a tick that wakes no sleeper is no news: the simulator does not wait for
+                # such a tick (board.py), so it needs no report of it
+                woke = now is not None and self._wake_sleepers(now)
+                news = woke or (now is None if news is None else news)
+                self._running -= 1
+                self._wake_pollers(news)
         self._after_change()
         if self.on_change is not None:
             self.on_change()
+
+    def parked(self):
+        """{(topic, peer, port)} of the connections whose reading thread sleeps now inside a
+        callback: what comes on them waits in the socket until it is back."""
+        with self._lock:
+            return self._parked()
+
+    def _parked(self):
+        return {entry[0] for tid, entries in self._in_callback.items()
+                if tid in self._sleeping for entry in entries if entry[2]}
+
+    def _callback_left(self, tid):
+        """The innermost callback record of thread `tid`, removed; None if it has none."""
+        entries = self._in_callback.get(tid)
+        if not entries:
+            return None
+        entry = entries.pop()
+        if not entries:
+            del self._in_callback[tid]
+        return entry
+
+    def _park_callbacks(self, tid):
+        """Thread `tid` sleeps until a later sim time inside callbacks (a learner's
+        rospy.sleep in a scan callback): they have done all they will do before that time, so
+        their messages count as taken in and the process may be done. Had they counted only
+        once they returned, the simulator would wait for them and they for its next tick."""
+        for entry in self._in_callback.get(tid, ()):
+            if not entry[2]:
+                entry[2] = True
+                key = entry[0]
+                self.taken[key] = self.taken.get(key, 0) + entry[1]
+                self._running -= 1
+                self._news = True
 
     def dropped(self, topic, port, count):
         """A subscriber's queue_size dropped `count` messages unread: they are done with."""
@@ -171,7 +218,11 @@ class Tracker:
             self._sleeping[tid] = (start, start + duration if start else None, duration)
             self._due.discard(tid)
             self._last[tid] = _OTHER
+            if tid in self._in_callback:
+                self._park_callbacks(tid)
         self._after_change()
+        if tid in self._in_callback and self.on_change is not None:
+            self.on_change()
 
     def sleep_start(self, tid):
         """The sim time [ns] thread `tid`'s sleep counts from, once known: for a sleep begun
@@ -364,7 +415,7 @@ class Tracker:
             wakes.append(1)             # waits for the first /clock: any tick wakes it
         return {"seq": self.seq, "taken": taken, "written": written,
                 "served": served, "called": called, "next_wake": min(wakes, default=0),
-                "watcher": self.watcher}
+                "watcher": self.watcher, "parked": sorted(self._parked())}
 
     def report_now(self):
         """A report of the counts as they are (for a simulator that just connected)."""
