@@ -67,7 +67,11 @@ run_rostests() {
     (
       set +u; source "$ROOT/$ws/devel/setup.bash"; set -u
       export PATH="$ROOT/.venv/bin:$PATH"
-      cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 2>&1
+      # the same CMake arguments as setup.sh's build: with others catkin_make runs CMake
+      # again, which rewrites devel/_setup_util.py while the other streams source the
+      # workspace (a batch test once failed on "can't open file .../_setup_util.py")
+      cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 \
+        -DPYTHON_EXECUTABLE="$ROOT/.venv/bin/python3" -DCATKIN_ENABLE_TESTING=ON 2>&1
     ) > "$RESULTS/$ws-run_tests.log"
     cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
   done
