@@ -67,11 +67,7 @@ run_rostests() {
     (
       set +u; source "$ROOT/$ws/devel/setup.bash"; set -u
       export PATH="$ROOT/.venv/bin:$PATH"
-      # the same CMake arguments as setup.sh's build: with others catkin_make runs CMake
-      # again, which rewrites devel/_setup_util.py while the other streams source the
-      # workspace (a batch test once failed on "can't open file .../_setup_util.py")
-      cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 \
-        -DPYTHON_EXECUTABLE="$ROOT/.venv/bin/python3" -DCATKIN_ENABLE_TESTING=ON 2>&1
+      cd "$ROOT/$ws" && rm -rf build/test_results && catkin_make run_tests -j1 2>&1
     ) > "$RESULTS/$ws-run_tests.log"
     cp -r "$ROOT/$ws/build/test_results" "$RESULTS/$ws" 2>/dev/null || true
   done
@@ -117,6 +113,17 @@ start_background() {
   background_pids+=($!)
 }
 if [ "$mode" != "--unit" ]; then
+  # catkin_make run_tests is called with other CMake arguments than setup.sh's build, so it
+  # runs CMake again, which rewrites each workspace's devel/_setup_util.py and setup files:
+  # done here, before the streams start, and not under a test that sources the workspace
+  # (a batch test once failed on "can't open file .../catkin_ws/devel/_setup_util.py")
+  for ws in simulation_ws catkin_ws; do
+    (
+      set +u; source "$ROOT/$ws/devel/setup.bash"; set -u
+      export PATH="$ROOT/.venv/bin:$PATH"
+      cd "$ROOT/$ws" && catkin_make -j1 tests 2>&1
+    ) > "$RESULTS/$ws-configure.log" || { echo "[test] catkin_make in $ws failed: test_results/$ws-configure.log"; status=1; }
+  done
   echo "[test] in the background (started now): the rostest suites of both workspaces; beside them $(basename "$WALL_BOUND")"
   start_background run_rostests
   start_background run_wall_bound
