@@ -247,19 +247,3 @@ def test_a_parked_connection_is_not_waited_for_until_a_report_says_it_is_read_ag
     assert board.busy({"/ctl"})[0] == "/ctl"
     board.take("/ctl", 1, 3, taken={("/scan", SIM, 5): 3}, written={})
     assert board.busy({"/ctl"}) is None
-
-
-def test_a_tick_that_followed_new_readings_is_waited_for_though_it_wakes_nobody():
-    """A lone controller's ticks go with word (tick_word.py): the one after new readings is
-    waited for, so that the next readings' callbacks see its time; the ticks between two
-    scans, which wake nobody, are not."""
-    board, own = make()
-    expect = ("/lockstep/expect", "/ctl", 7)
-    own.written[expect] = 2                               # HOLD, then the tick after a scan
-    board.tick_followed_readings("/ctl", 7, 2)
-    board.take("/ctl", 1, 1, taken={("/lockstep/expect", SIM, 7): 1}, written={})
-    assert board.busy({"/ctl"})[0] == "/ctl"
-    board.take("/ctl", 1, 2, taken={("/lockstep/expect", SIM, 7): 2}, written={})
-    assert board.busy({"/ctl"}) is None
-    own.written[expect] = 4                               # two ticks between scans
-    assert board.busy({"/ctl"}) is None

@@ -82,11 +82,3 @@ def test_a_tick_does_not_wait_for_messages_behind_a_callback_asleep_in_sim_time(
     started = time.monotonic()
     hold.wait(SIM, {(SCAN, SCAN_PORT): 2}, time.monotonic)
     assert hold.late == 0 and time.monotonic() - started < 0.5 * tick_hold.HOLD_CAP
-
-
-def test_a_tick_says_whether_it_follows_new_readings():
-    hold = TickHold(lambda: {(SCAN, SIM, SCAN_PORT): 3}, lambda: set())
-    hold.heard_hold(SIM, clock_port=CLOCK_PORT, clock_count=0)
-    assert hold.wait(SIM, {(SCAN, SCAN_PORT): 1}, time.monotonic)      # after a scan
-    assert not hold.wait(SIM, {(SCAN, SCAN_PORT): 1}, time.monotonic)  # between two scans
-    assert hold.wait(SIM, {(SCAN, SCAN_PORT): 2}, time.monotonic)

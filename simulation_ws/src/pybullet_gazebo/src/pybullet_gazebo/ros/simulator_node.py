@@ -106,7 +106,7 @@ class SimulatorNode:
             own.on_change = self.board.notify
             # a lone loop node's tick goes out with its readings and word of what it must
             # follow (lockstep/tick_word.py)
-            self.tick_word = TickWord(own, followed_readings=self.board.tick_followed_readings)
+            self.tick_word = TickWord(own)
             # no Nagle on the reports: a report held back for the last one's ACK would hold
             # the simulation for the receiver's delayed ACK
             self._report_sub = rospy.Subscriber(REPORT_TOPIC, LockstepReport, self._on_report,

@@ -98,7 +98,6 @@ class Board:
         self._version = 0            # counts changes, so that a wait misses none
         self.silent = set()          # nodes stepped past at a time-out, until they add up
         self.clock_sent = {}         # node -> [ns sim] the last /clock tick sent to it
-        self.tick_floor = {}         # (EXPECT_TOPIC, node, port) -> ticks there to wait for
 
     # --- what comes in ----------------------------------------------------------------------
     def take(self, node, pid, seq, taken, written, served=(), called=(), next_wake=0,
@@ -132,13 +131,6 @@ class Board:
             for node in nodes:
                 self.clock_sent[node] = stamp_ns
 
-    def tick_followed_readings(self, node, port, count):
-        """The `count`-th tick sent to `node` with word (tick_word.py) followed new readings:
-        it is waited for like readings, though it wakes no sleeper, so that the next
-        readings' callbacks see its time."""
-        with self._changed:
-            self.tick_floor[(EXPECT_TOPIC, node, port)] = count
-
     def notify(self):
         """The simulator's own counts changed (it read a command)."""
         with self._changed:
@@ -152,8 +144,6 @@ class Board:
         with self._changed:
             self._reports.pop(node, None)
             self.silent.discard(node)
-            for key in [k for k in self.tick_floor if k[1] == node]:
-                del self.tick_floor[key]
 
     def watchers(self):
         """The nodes that said they only watch."""
@@ -234,20 +224,15 @@ class Board:
         if report.watcher:
             return None
         # a tick that reaches no sleeper's wake-up wakes nothing: rospy only takes its time
-        # (the next one that does is waited for, with every tick before it); one sent with
-        # word after new readings is waited for all the same (tick_followed_readings)
+        # (the next one that does is waited for, with every tick before it)
         skip_clock = report.next_wake == 0 or report.next_wake > self.clock_sent.get(node, 0)
         for (topic, peer, port), count in written_own.items():
             # (ticks also go with word of what they follow, lockstep/tick_word.py)
-            if peer != node:
-                continue
-            taken = report.taken.get((topic, me, port), 0)
-            if skip_clock and topic == EXPECT_TOPIC:
-                count = min(count, self.tick_floor.get((topic, node, port), 0))
-            elif skip_clock and topic == CLOCK:
-                continue
-            if taken < count and (topic, me, port) not in report.parked:
-                return node, "%s not taken in: %d of %d" % (topic, taken, count)
+            if peer == node and report.taken.get((topic, me, port), 0) < count \
+                    and not (skip_clock and topic in (CLOCK, EXPECT_TOPIC)) \
+                    and (topic, me, port) not in report.parked:
+                return node, "%s not taken in: %d of %d" % (
+                    topic, report.taken.get((topic, me, port), 0), count)
         for (topic, peer, port), count in report.written.items():
             if peer == me:
                 # only on a connection the simulator has: a report cannot make it wait

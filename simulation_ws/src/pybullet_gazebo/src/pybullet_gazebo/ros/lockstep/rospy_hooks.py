@@ -33,7 +33,6 @@ from pybullet_gazebo.ros.lockstep.tick_hold import HOLD, TICK, TickHold
 from pybullet_gazebo.ros.lockstep.tracker import Tracker
 
 NOT_COUNTED = {"/rosout", REPORT_TOPIC}     # topics no controller acts on
-_TICK_NEWS = threading.local()  # .value: the tick just read followed new readings (tick_hold)
 
 TRACKER = None                              # this process's Tracker, once installed
 TICK_HOLD = None                            # ... and its TickHold (controllers only)
@@ -108,12 +107,8 @@ def install(report=True):
                 # /clock tick; a HOLD always (the simulator counts on it from then on)
                 if any(m.kind == TICK for m in msgs):
                     now = rospy.rostime.get_rostime().to_nsec()
-                # a tick that follows new readings too: the simulator waits for word of it
-                # before it sends more (tick_hold.py)
-                news = getattr(_TICK_NEWS, "value", False) or (
-                    any(m.kind == HOLD for m in msgs)
-                    and connection.callerid_pub in _clock_publishers())
-                _TICK_NEWS.value = False
+                news = any(m.kind == HOLD for m in msgs) and \
+                    connection.callerid_pub in _clock_publishers()
             tracker.callback_ended(topic, connection.callerid_pub, port, len(msgs), now, news,
                                    tid)
     rospy.topics._SubscriberImpl.receive_callback = counted_receive_callback
@@ -452,11 +447,9 @@ def _subscribe_ticks(hold):
         if msg.kind == HOLD:
             hold.heard_hold(simulator, msg.clock_port, msg.clock_count)
         elif msg.kind == TICK:
-            # (a message has __slots__: the word goes to counted_receive_callback, which
-            # runs this callback in the same thread, by a thread-local)
-            _TICK_NEWS.value = hold.wait(
-                simulator, {(t, port): n for t, port, n in zip(msg.topics, msg.ports,
-                                                              msg.counts)}, time.monotonic)
+            hold.wait(simulator, {(t, port): n for t, port, n in zip(msg.topics, msg.ports,
+                                                                       msg.counts)},
+                      time.monotonic)
             rospy.rostime._set_rostime(msg.clock)      # what rospy's /clock subscriber does
 
     rospy.Subscriber(EXPECT_TOPIC, LockstepExpect, heard, queue_size=None, tcp_nodelay=True)

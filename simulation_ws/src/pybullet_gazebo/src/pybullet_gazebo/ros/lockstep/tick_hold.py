@@ -36,7 +36,6 @@ class TickHold:
         self._changed = threading.Condition()
         self._changed._lockstep_untracked = True      # (its waits are not the program's)
         self._before = {}           # simulator -> {(topic, port): count}: /clock before HOLD
-        self._last = {}             # simulator -> the counts its last tick named
         self.late = 0               # ticks set without their counts, after HOLD_CAP
 
     def heard_hold(self, simulator, clock_port, clock_count):
@@ -44,7 +43,6 @@ class TickHold:
         `clock_count` on the /clock connection whose end here has `clock_port`."""
         with self._changed:
             self._before[simulator] = {(CLOCK, clock_port): clock_count}
-            self._last[simulator] = {}
 
     def taken_changed(self):
         """A callback returned: the counts grew."""
@@ -55,13 +53,8 @@ class TickHold:
     def wait(self, simulator, counts, wall_clock):
         """Returns once this process has taken in `counts` ({(topic, port): count}) from
         `simulator`, and the /clock ticks it sent before its HOLD. `wall_clock()`: for
-        HOLD_CAP. True when the tick follows readings its last tick did not (its counts
-        changed): the simulator waits for word of such a tick before it sends more readings,
-        so that a callback of those sees the time of this tick, not an earlier one
-        (tick_word.py keeps the same rule)."""
+        HOLD_CAP."""
         with self._changed:
-            follows_readings = counts != self._last.get(simulator, {})
-            self._last[simulator] = dict(counts)
             needed = dict(self._before.get(simulator, {}))
             needed.update(counts)
             deadline = None
@@ -71,9 +64,8 @@ class TickHold:
                     deadline = now + HOLD_CAP
                 elif now >= deadline:
                     self.late += 1
-                    return follows_readings
+                    return
                 self._changed.wait(deadline - now)
-            return follows_readings
 
     def _reached(self, counts, publisher):
         if not counts:
@@ -87,4 +79,3 @@ class TickHold:
         """A forked child: no simulator has said anything to it."""
         with self._changed:
             self._before = {}
-            self._last = {}

@@ -24,16 +24,11 @@ _NOT_NAMED = (CLOCK, EXPECT_TOPIC)       # topics a tick's counts leave out
 
 class TickWord:
     def __init__(self, tracker, publisher=None,
-                 live_outbound=rospy_hooks.outbound_connections, port_of=rospy_hooks.peer_port,
-                 followed_readings=lambda node, port, count: None):
+                 live_outbound=rospy_hooks.outbound_connections, port_of=rospy_hooks.peer_port):
         """`tracker`: the simulator's own Tracker (what it wrote to whom); `publisher`: of the
         ticks (a DirectPublisher on /lockstep/expect by default); `live_outbound()`:
         {(topic, subscriber, port)} of the simulator's publisher connections open now;
-        `port_of(connection)`: the port of its subscriber's end; `followed_readings(node,
-        port, count)`: the `count`-th tick on that connection followed readings the tick
-        before it did not (the board waits for word of it before more readings go out)."""
-        self._followed_readings = followed_readings
-        self._last = {}                     # node -> the counts its last tick named
+        `port_of(connection)`: the port of its subscriber's end."""
         self.publisher = publisher or DirectPublisher(EXPECT_TOPIC, LockstepExpect)
         self.offered = frozenset()          # nodes told HOLD at their next tick
         self._tracker = tracker
@@ -70,12 +65,6 @@ class TickWord:
                 word.ports.append(port)
                 word.counts.append(count)
         self._write(connection, word)
-        counts = dict(zip(zip(word.topics, word.ports), word.counts))
-        if counts != self._last.get(node, {}):      # (tick_hold.py keeps the same rule)
-            self._last[node] = counts
-            port = self._port_of(connection)
-            self._followed_readings(node, port, self._tracker.written_to(node).get(
-                (EXPECT_TOPIC, port), 0))
         return True
 
     def _hold(self, node, connection, clock_connection):
@@ -88,7 +77,6 @@ class TickWord:
         if self._tracker.written_to(node).get(key, 0) <= before.get(key, 0):
             return False
         self._told[node] = connection
-        self._last[node] = {}
         return True
 
     def holding(self, node):
