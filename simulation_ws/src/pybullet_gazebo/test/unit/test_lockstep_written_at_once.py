@@ -125,3 +125,31 @@ def test_rosout_and_a_process_without_simulator_keep_the_queue(listening, queued
     connection.write_data(b"message")
     assert received(subscriber, b"message") == b"message"
     assert ours.writers and ours.writers[0] != threading.get_ident()     # the queue's thread
+
+
+def test_a_subscriber_gone_mid_write_ends_the_connection_without_hanging(listening, queued):
+    """The subscriber's end closed (a `rostopic echo` stopped with Ctrl-C, a simulator killed):
+    rospy's transport closes itself on the broken pipe and calls the queue's clean-up, which
+    takes the queue's lock. The publishing thread, writing under that lock, must not wait for
+    itself: the publish ends as rospy's does (TransportTerminated, which rospy's publish
+    drops), and the program goes on."""
+    from rospy.exceptions import TransportTerminated
+    connection, ours, subscriber = queued()
+    subscriber.close()
+    ended = []
+
+    def publish_until_it_fails():
+        for _ in range(100):
+            try:
+                connection.write_data(b"command")
+            except TransportTerminated as error:
+                ended.append(error)
+                return
+            except OSError as error:            # (a reset before the pipe breaks)
+                ended.append(error)
+    writer = threading.Thread(target=publish_until_it_fails, daemon=True)
+    writer.start()
+    writer.join(5.0)
+    assert not writer.is_alive(), "the publishing thread waits for its own lock"
+    assert any(isinstance(e, TransportTerminated) for e in ended), ended
+    assert connection._connection.done

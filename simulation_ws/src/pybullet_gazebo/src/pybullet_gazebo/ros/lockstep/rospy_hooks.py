@@ -175,13 +175,28 @@ def install(report=True):
                 # thread cannot start a write meanwhile), as that thread would write it: out
                 # when publish() returns, so the subscriber gets it and the process is done
                 # without waiting for the queue's thread to wake and take the GIL
-                return written_and_counted(self._connection, data)
+                self._lockstep_writer = get_ident()
+                try:
+                    return written_and_counted(self._connection, data)
+                finally:
+                    self._lockstep_writer = None
             if not (self._queue_size > 0 and len(self._queue) == self._queue_size):
                 self._lockstep_pending += 1     # (a full queue drops its oldest: no change)
                 waiting.add(self)
         return queued_write(self, data)
+    closed_callback = tcpros_pubsub.QueuedConnection._closed_connection_callback
+
+    def closed_while_writing(self, connection):
+        # a broken pipe in the write above closes the transport, which calls this back in
+        # the same thread, with the queue's lock held: wake the queue's thread (it ends, the
+        # transport being done) without taking the lock again, which would wait forever
+        if getattr(self, "_lockstep_writer", None) == get_ident():
+            self._cond_data_available.notify()
+            return
+        closed_callback(self, connection)
     tcpros_pubsub.QueuedConnection.__init__ = tracked_queued_init
     tcpros_pubsub.QueuedConnection.write_data = counted_queued_write
+    tcpros_pubsub.QueuedConnection._closed_connection_callback = closed_while_writing
 
     publish = rospy.topics.Publisher.publish
 
