@@ -528,6 +528,12 @@ class SimulatorNode:
             self.clock_pub.publish(stamp, loop_nodes=not lockstep)
             if lockstep:
                 self._loop_clock = stamp
+        if contacts_changed:
+            # before the readings of the same step: a client that takes the scan for the end
+            # of its step (m2wr_gym's ROS backend) then has the touch too (after them, it
+            # could read the scan first and see the touch a step late: CI run 103)
+            self._last_touching = touching
+            self._publish_contacts(touching, stamp)
         if readings:
             self.lockstep.sending()
         scans = 0
@@ -538,9 +544,6 @@ class SimulatorNode:
         if self._loop_clock is not None and self._tick_goes_with_readings():
             self._hand_on_tick()
             self.lockstep.stats.ticks_with_readings += 1
-        if contacts_changed:
-            self._last_touching = touching
-            self._publish_contacts(touching, stamp)
         if model_states_due:
             self.state_topics.publish()
         return scans
