@@ -54,21 +54,6 @@ def test_the_same_run_to_the_bit_with_both_cores_busy(tmp_path, controller, requ
         assert "watched in /proc" not in line, line
 
 
-def test_ticks_that_wake_nobody_go_inside_the_stretch_and_change_nothing(
-        tmp_path, tutorial_on_an_idle_machine):
-    """The tutorial's program answers scans and has no loop: at the launch's /clock 100 Hz,
-    the four ticks between two scans wake nothing in it. They go out inside the stretch of
-    physics (each used to end it and wait for the callback of the scan before it), and the
-    run is the one at /clock 20 Hz, where no tick falls between two scans, to the bit."""
-    at_100_hz = tutorial_on_an_idle_machine
-    line = lockstep_line(at_100_hz)
-    assert "inside a stretch of physics" in line, line
-    at_20_hz = run(tmp_path, "--clock-hz", "20")
-    assert "inside a stretch of physics" not in lockstep_line(at_20_hz)
-    assert at_100_hz["track_sha256"] == at_20_hz["track_sha256"], (at_100_hz["m2wr"],
-                                                                  at_20_hz["m2wr"])
-
-
 def ticks_and_scans(log_dir):
     """tick_reader.py's notes: [(sim time of a turn, stamp of the latest scan it had)] [ns]."""
     with open(os.path.join(str(log_dir), "ticks.txt")) as notes:

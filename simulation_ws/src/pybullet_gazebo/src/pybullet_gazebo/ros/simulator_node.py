@@ -124,9 +124,8 @@ class SimulatorNode:
                 "on (lockstep_timeout; counted in the run summary)" % (who,
                                                                      params.lockstep_timeout)))
         self._loop_clock = None                   # lockstep: /clock the loop nodes are owed
-        self._owed = None                         # ... the nodes still owed it, in turns
+        self._owed = None                         # ... the nodes still owed it, in name order
         self._handed_on = False                   # ... a tick went out inside this stretch
-        self._ticks_in_stretch = False            # the next stretch runs past its ticks
         self._watched_key = None                  # lockstep: the loop connections watched now
         self._watched_names = set()               # ... and their nodes
         self._leaving = set()                     # reporters whose report connection closed
@@ -329,18 +328,10 @@ class SimulatorNode:
         tick went out at the stretch's end. The lock stays held to the stretch's end and the
         loop settles there, so a service call the tick makes is served at that step whatever
         the machine's speed; no model_states step ends the stretch (their wall-time limit
-        would make where it ends the machine's choice): they are published inside it.
-
-        Lockstep, when the next /clock tick wakes nobody (_tick_wakes_nobody: its one loop
-        node gets its ticks with word and has no thread asleep until then): step by step
-        too, and that tick, and the next ones while they wake nobody, go out at their steps
-        inside the stretch, which runs on to the drive update instead of ending at each."""
+        would make where it ends the machine's choice): they are published inside it."""
         world = self.world
         if not (self.lockstep.enabled and self._loop_clock is not None):
-            ahead = self._steps_ahead()
-            if self._ticks_in_stretch:
-                return self._advance_past_ticks(ahead)
-            return world.advance(ahead, until_news=True)
+            return world.advance(self._steps_ahead(), until_news=True)
         ahead = self._steps_ahead(model_states=False)
         changes = world.contacts.changes
         self._watch_loop_nodes()
@@ -356,29 +347,6 @@ class SimulatorNode:
                     self._handed_on = True
                     self.lockstep.stats.ticks_while_stepping += 1
         return []
-
-    def _advance_past_ticks(self, ahead):
-        """Physics `ahead` steps (fewer at news), in pieces that end at the /clock ticks on
-        the way: each goes out at its step while it wakes nobody (_tick_wakes_nobody); the
-        first that may wake someone ends the stretch there, to be settled and sent as usual.
-        Call with the world's lock held."""
-        world = self.world
-        changes = world.contacts.changes
-        end = world.step_count + ahead
-        continues = False               # (a tick changes nothing in the world: see Stepper)
-        while True:
-            to_tick = self._clock_every - (world.step_count - self._last_clock_step)
-            readings = world.advance(max(1, min(end - world.step_count, to_tick)),
-                                     until_news=True, continues=continues,
-                                     horizon=end - world.step_count)
-            continues = True
-            if readings or world.contacts.changes != changes or world.step_count >= end:
-                return readings
-            if self._clock_due(force=False, peek=True):
-                if not self._tick_wakes_nobody(world.sim_time_ns()):
-                    return []                   # (settled and sent at the stretch's end)
-                self._publish([])               # the tick, with word, and what else is due
-                self.lockstep.stats.ticks_in_stretch += 1
 
     def _settle_loop_nodes(self):
         """Lockstep: waits until the loop nodes are done with what they were sent, then
@@ -401,22 +369,16 @@ class SimulatorNode:
         """The owed /clock tick to the next loop node that has not had it. One node at a
         time, in the order of their names: when one node's tick acts on another (bug 2
         switching go to point on by a service call), which ticks first is then the same on
-        every run, not the machine's choice. A node that said it only watches (the demo's
-        recorder) acts on nothing: it has its tick with the first node's, not a turn of its
-        own ahead of the controllers'. True when a tick went out."""
+        every run, not the machine's choice. True when a tick went out."""
         if self._owed is None:
-            watchers = self._watched_names & self.board.watchers()
-            self._owed = [sorted(watchers)] if watchers else []
-            self._owed += [[node] for node in sorted(self._watched_names - watchers)]
-            if len(self._owed) > 1 and watchers:
-                self._owed[0:2] = [self._owed[0] + self._owed[1]]
+            self._owed = sorted(self._watched_names)
         sent = bool(self._owed)
         if sent:
             self.lockstep.sending()
             self.lockstep.stats.ticks += 1
-            nodes = self._owed.pop(0)
-            self.board.sent_clock(nodes, self._loop_clock.to_nsec())
-            self.clock_pub.publish_to_loop_nodes(self._loop_clock, set(nodes))
+            node = self._owed.pop(0)
+            self.board.sent_clock((node,), self._loop_clock.to_nsec())
+            self.clock_pub.publish_to_loop_nodes(self._loop_clock, {node})
         if not self._owed:
             self._loop_clock = self._owed = None
         return sent
@@ -428,34 +390,14 @@ class SimulatorNode:
         # a tick sent with the readings spares a round trip only when one node is owed each
         # tick: with several, each gets its tick once the one before is done with its own. A
         # node that said it only watches (a recorder, the benchmark's listener) is owed nothing.
-        node = self._lone_reporting_node()
-        self.tick_word.offer(() if node is None else (node,))
-        return node is not None and self.tick_word.holding(node)
-
-    def _lone_reporting_node(self):
-        """The one loop node owed each tick, if it reports (else None)."""
         names = self._watched_names - self.board.watchers()
         if len(names) != 1 or not names <= self.lockstep.reporting or self.lockstep.watching \
                 or self._leaving:
-            return None
-        node, = names
-        return node
-
-    def _tick_wakes_nobody(self, stamp_ns):
-        """Whether the tick of `stamp_ns` [ns sim] may go out inside a stretch of physics,
-        without a report of the readings first: its node gets its ticks with word of what
-        they follow (its process sets one only once the readings before it went through their
-        callbacks, tick_hold.py), and its latest report names no thread asleep until then.
-        Nothing in it then acts on the tick: a program that answers scans (the tutorial's,
-        at the launch's /clock 100 Hz) reads the same time in its callbacks, and its answer
-        is read at the same drive update, as when each tick ended a stretch and waited for
-        the callback of the scan before it: the stretch runs on to the drive update."""
-        node = self._lone_reporting_node()
-        if node is None or not self.tick_word.holding(node):
+            self.tick_word.offer(())
             return False
-        report = self.board.report_of(node)
-        return report is not None and not report.parked and \
-            (report.next_wake == 0 or report.next_wake > stamp_ns)
+        node, = names
+        self.tick_word.offer(names)
+        return self.tick_word.holding(node)
 
     def _watch_loop_nodes(self):
         """Lockstep waits for the loop nodes: by their reports when they send them (the
@@ -549,11 +491,12 @@ class SimulatorNode:
         message out: faster than real time most of its due steps are skipped, and stopping
         at each (every 4 steps at 50 Hz) cut the loop's stretches to 4 steps whenever
         anyone listened."""
-        self._ticks_in_stretch = False
         if self.real_time_factor > 0 or self.window is not None:
             return 1
         world = self.world
         ahead = MAX_STEPS_AHEAD
+        if self.clock_pub is not None:
+            ahead = min(ahead, self._clock_every - (world.step_count - self._last_clock_step))
         if model_states and self.state_topics.wanted():
             ahead = min(ahead, self._model_states_every
                         - world.step_count % self._model_states_every)
@@ -563,14 +506,6 @@ class SimulatorNode:
             while steps < ahead and world.time_after(steps) < needed_at:
                 steps += 1
             ahead = min(ahead, steps)
-        if self.clock_pub is not None:
-            to_tick = self._clock_every - (world.step_count - self._last_clock_step)
-            if 0 < to_tick < ahead and self.lockstep.enabled and self._loop_clock is None \
-                    and self._tick_wakes_nobody(
-                        world.sim_time_ns() + to_tick * int(round(world.step_size * 1e9))):
-                self._ticks_in_stretch = True   # (_advance_past_ticks sends it on its way)
-            else:
-                ahead = min(ahead, to_tick)
         return max(1, ahead)
 
     def _loop_nodes(self):

@@ -47,7 +47,6 @@ class LockstepStats:
         self.ticks_while_stepping = 0   # /clock ticks handed on while physics ran on
         self.ticks = 0                  # /clock ticks handed on to a loop node in all
         self.ticks_with_readings = 0    # ... sent with the readings (tick_word.py)
-        self.ticks_in_stretch = 0       # ... of them, inside a stretch of physics
         self.handshake = set()          # controllers waited for by their reports
         self.watched = set()            # ... and by the /proc watch (no reports)
 
@@ -59,8 +58,6 @@ class LockstepStats:
                 self.ticks_while_stepping, self.ticks)
             if self.ticks_with_readings:
                 text += " and %d sent with the readings" % self.ticks_with_readings
-                if self.ticks_in_stretch:
-                    text += " (%d of them inside a stretch of physics)" % self.ticks_in_stretch
         if self.stepped_past:
             text += " (still at work: %s)" % ", ".join(
                 "%s %d x" % item for item in sorted(self.stepped_past.items()))
