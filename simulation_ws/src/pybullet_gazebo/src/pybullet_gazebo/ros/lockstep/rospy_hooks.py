@@ -158,6 +158,9 @@ def install(report=True):
     queued_write = tcpros_pubsub.QueuedConnection.write_data
 
     def tracked_queued_init(self, connection, queue_size):
+        # the thread writing directly, if any (set before rospy's init, during which the
+        # connection may already close and call closed_while_writing)
+        self._lockstep_writer = None
         queued_init(self, connection, queue_size)
         self._lockstep_pending = 0
         # (/rosout stays queued: no controller waits for it, so its write is left to the
@@ -184,13 +187,14 @@ def install(report=True):
                 self._lockstep_pending += 1     # (a full queue drops its oldest: no change)
                 waiting.add(self)
         return queued_write(self, data)
+
     closed_callback = tcpros_pubsub.QueuedConnection._closed_connection_callback
 
     def closed_while_writing(self, connection):
         # a broken pipe in the write above closes the transport, which calls this back in
         # the same thread, with the queue's lock held: wake the queue's thread (it ends, the
         # transport being done) without taking the lock again, which would wait forever
-        if getattr(self, "_lockstep_writer", None) == get_ident():
+        if self._lockstep_writer == get_ident():
             self._cond_data_available.notify()
             return
         closed_callback(self, connection)
